@@ -1,0 +1,92 @@
+/* tcbench — run configuration (JSON, validated; errors name the key).
+ *
+ *   { "name": "quick",
+ *     "output": "runs/quick",            run directory (relative to the CWD)
+ *     "splits_dir": "splits",            where split files live (written once)
+ *     "cache_dir": ".tcbench-cache",     parsed-sequence cache ("" disables)
+ *     "plugins": ["path/lib.so"],        optional out-of-tree methods
+ *     "seeds": [0],
+ *     "threads": 2,
+ *     "evaluation": { "pairs": 500, "split_seed": 2021, "pool_size": 10000,
+ *                     "pool_seed": 0, "input_points": 2500 },
+ *     "datasets": [
+ *       { "name": "synth", "source": "synthetic", "seed": 0, "frames": 0,
+ *         "normalization": "first_frame" | "none" | "per_frame",
+ *         "sampling": "without_replacement" | "with_replacement",
+ *         "optional": false,             skip (with a message) when root is absent
+ *         "root": "../shared/data/anim", objdir sources only: <root>/<sequence>/
+ *         "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
+ *     "methods": [ { "name": "oracle" },
+ *                  { "name": "mca-cpu", "method": "mca", "params": { … } } ] }
+ * Unknown keys anywhere are errors. */
+#ifndef TCB_CONFIG_H
+#define TCB_CONFIG_H
+
+#include <stdint.h>
+
+#include "tcb/error.h"
+#include "tcb/fsutil.h"
+#include "tcb/sequence.h"
+#include "tcb/split.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum tcb_source { TCB_SOURCE_SYNTHETIC, TCB_SOURCE_OBJDIR } tcb_source;
+
+typedef struct tcb_sequence_spec {
+    char name[TCB_NAME_MAX];
+    tcb_role role;
+} tcb_sequence_spec;
+
+typedef struct tcb_dataset_spec {
+    char name[64];
+    tcb_source source;
+    char root[TCB_PATH_MAX];
+    uint64_t seed;           /* synthetic generator seed */
+    int frames;              /* synthetic: 0 = default length */
+    tcb_normalization norm;
+    int with_replacement;
+    int optional;
+    int n_sequences;
+    tcb_sequence_spec *sequences;
+} tcb_dataset_spec;
+
+typedef struct tcb_method_spec {
+    char label[64];          /* "name": unique within the config, used in results */
+    char method[64];         /* registered method ("method", default = label) */
+    char *params_json;       /* compact JSON object text, "{}" by default */
+} tcb_method_spec;
+
+typedef struct tcb_config {
+    char path[TCB_PATH_MAX];
+    char name[64];
+    char output[TCB_PATH_MAX];
+    char splits_dir[TCB_PATH_MAX];
+    char cache_dir[TCB_PATH_MAX];
+    int n_plugins;
+    char **plugins;
+    int n_seeds;
+    int *seeds;
+    int threads;
+    int eval_pairs;
+    uint64_t split_seed;
+    int pool_size;
+    uint64_t pool_seed;
+    int input_points;
+    int n_datasets;
+    tcb_dataset_spec *datasets;
+    int n_methods;
+    tcb_method_spec *methods;
+    char *json_text;         /* the normalized config, saved beside the results */
+} tcb_config;
+
+int tcb_config_load(const char *path, tcb_config *out, tcb_error *err);
+int tcb_config_parse(const char *text, const char *origin, tcb_config *out, tcb_error *err);
+void tcb_config_free(tcb_config *c);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,36 @@
+/* tcbench — triangle-mesh geometry: areas, normals, area-uniform sampling. */
+#ifndef TCB_GEOMETRY_H
+#define TCB_GEOMETRY_H
+
+#include <stdint.h>
+
+#include "tcb/error.h"
+#include "tcb/rng.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+double tcb_triangle_area(const float *a, const float *b, const float *c);
+
+/* Sum of triangle areas; faces are [nf][3] vertex ids. */
+double tcb_mesh_area(const float *verts, const int32_t *faces, int nf);
+
+/* Area-weighted centroid of the surface (the expectation of an area-uniform sample). */
+void tcb_surface_centroid(const float *verts, const int32_t *faces, int nf, double c[3]);
+
+/* Area-weighted vertex normals, unit length; zero for vertices on no
+ * non-degenerate face. normals is [nv][3]. */
+void tcb_vertex_normals(const float *verts, int nv, const int32_t *faces, int nf,
+                        float *normals);
+
+/* n samples uniform over the surface area (face by area, then a uniform
+ * barycentric point: the PyTorch3D sample_points_from_meshes scheme).
+ * out is [n][3]. Fails on a zero-area mesh. */
+int tcb_sample_surface(const float *verts, const int32_t *faces, int nf, int n,
+                       tcb_rng *rng, float *out, tcb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,35 @@
+/* tcbench — one triangle mesh, and the Wavefront OBJ reader/writer.
+ *
+ * The reader accepts `v x y z`, `f` with `v`, `v/vt`, `v//vn`, `v/vt/vn`
+ * forms, negative (relative) indices, polygons (fan-triangulated) and
+ * comments; it ignores vt/vn/o/g/s/usemtl/mtllib lines. It rejects bad
+ * numbers, NaN/Inf, zero or out-of-range indices, faces with < 3 vertices
+ * and files without faces, naming file and line. */
+#ifndef TCB_MESH_H
+#define TCB_MESH_H
+
+#include <stdint.h>
+
+#include "tcb/error.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct tcb_mesh {
+    int n_verts;
+    int n_faces;
+    float *verts;    /* [n_verts][3] */
+    int32_t *faces;  /* [n_faces][3], 0-based */
+} tcb_mesh;
+
+int tcb_obj_read(const char *path, tcb_mesh *out, tcb_error *err);
+/* Written atomically. */
+int tcb_obj_write(const char *path, const float *verts, int nv, const int32_t *faces,
+                  int nf, tcb_error *err);
+void tcb_mesh_free(tcb_mesh *m);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

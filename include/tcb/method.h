@@ -1,0 +1,86 @@
+/* tcbench — the method interface.
+ *
+ * A method is a versioned table of function pointers, in the manner of
+ * SQLite's sqlite3_module: the harness never knows a method by name, only
+ * through this table. The harness owns data loading, the evaluation pairs,
+ * metrics and all I/O; a method owns only its model.
+ *
+ * Lifecycle for one (dataset, sequence, method, seed) cell:
+ *     create(params_json) → [load(checkpoint) | fit(seq)] → transfer(i, j, …)
+ *     × n_pairs → reconstruct(…) × 2 n_pairs (optional) → destroy
+ *
+ * Rules:
+ *  - Return TCB_OK or an error code with a one-line message in *err.
+ *    Never print, never exit(); use ctx->reporter for progress and logs.
+ *  - Methods are unsupervised: they may read the sequence's vertices, faces
+ *    and point pools, but must not use the fact that vertex ids correspond
+ *    across frames (only the `oracle` sanity row does, by design).
+ *  - All randomness comes from the seed in tcb_fit_ctx or the rng passed to
+ *    transfer/reconstruct: the same seed and thread count give the same bits.
+ *
+ * Out-of-tree plug-ins: a shared object that exports
+ *     const tcb_method_ops *const *tcb_plugin_methods(int *count);
+ * returning `count` tables with abi_version == TCB_METHOD_ABI_VERSION,
+ * loaded with `tcbench --plugin path/to/lib.so …` or the config key
+ * "plugins". See docs/adding-a-method.md. */
+#ifndef TCB_METHOD_H
+#define TCB_METHOD_H
+
+#include <stdint.h>
+
+#include "tcb/error.h"
+#include "tcb/progress.h"
+#include "tcb/rng.h"
+#include "tcb/sequence.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TCB_METHOD_ABI_VERSION 1
+
+typedef struct tcb_fit_ctx {
+    uint64_t seed;          /* the cell's seed */
+    int n_threads;          /* threads the method may use */
+    const char *work_dir;   /* per-cell directory for checkpoints; exists */
+    tcb_reporter reporter;  /* progress bar and log */
+} tcb_fit_ctx;
+
+typedef struct tcb_method_ops {
+    int abi_version;            /* TCB_METHOD_ABI_VERSION */
+    const char *name;           /* unique, [a-z0-9_]+ */
+    const char *description;    /* one line for `tcbench methods` */
+
+    /* Parse params (a JSON object as text, "{}" for defaults); unknown keys
+     * and bad values are TCB_ERR_INPUT naming the key. */
+    int (*create)(const char *params_json, void **self, tcb_error *err);
+
+    /* Train or precompute on the whole sequence (one model per sequence). */
+    int (*fit)(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_error *err);
+
+    /* Map n points src (the GT vertices of frame i, [n][3]) to points on
+     * frame j, out [n][3]. The harness then projects out onto frame j's GT
+     * vertices. rng is the pair's stream (fresh input clouds etc.). */
+    int (*transfer)(void *self, const tcb_sequence *seq, int i, int j, const float *src,
+                    int n, float *out, tcb_rng *rng, tcb_error *err);
+
+    /* Optional (NULL: no reconstruction, "-" in CD columns). Surface samples
+     * of `frame` (i or j) in the context of pair (i, j), as evaluated after
+     * transfer(i, j); *pts is malloc'ed [*n][3] and freed by the caller. */
+    int (*reconstruct)(void *self, const tcb_sequence *seq, int i, int j, int frame,
+                       tcb_rng *rng, float **pts, int *n, tcb_error *err);
+
+    /* Optional checkpointing of a fitted model (NULL: refit on resume). */
+    int (*save)(void *self, const char *path, tcb_error *err);
+    int (*load)(void *self, const tcb_sequence *seq, const char *path, tcb_error *err);
+
+    void (*destroy)(void *self);
+} tcb_method_ops;
+
+typedef const tcb_method_ops *const *(*tcb_plugin_entry_fn)(int *count);
+#define TCB_PLUGIN_ENTRY "tcb_plugin_methods"
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,87 @@
+/* tcbench — correspondence and reconstruction metrics, exactly as the
+ * authors' evaluation code computes them (reference-protocol §5.4–§5.6).
+ *
+ * Per pair (i → j) every GT vertex q^i_k is transferred by the method to a
+ * point on frame j, then projected to its nearest GT vertex of j, giving a
+ * predicted vertex id pred[k]. With d_k = ||q^j_pred[k] − q^j_k||²:
+ *   m_sL2  = mean_k sqrt(d_k)              (code; ×1e3 in tables)
+ *   sL2²   = mean_k d_k                    (the paper's literal formula, stored alongside)
+ *   rank   = mean_k #{l : ||q^j_l − q^j_k||² < d_k} / K   (×100)
+ *   PCK_s  = frac_k [d_k ≤ t_s], t_s = linspace(0, 0.02, 100) on SQUARED distances
+ *   AUC    = mean_s PCK_s                  (×100)
+ *   CD     = mean_a min_b |a−b|² + mean_b min_a |a−b|²   (×1e3)
+ * sL2 and rank mean ± std are pooled over all vertices of all pairs; AUC and
+ * CD mean ± std are over pairs (numpy std, ddof = 0). */
+#ifndef TCB_METRICS_H
+#define TCB_METRICS_H
+
+#include <stdint.h>
+
+#include "tcb/error.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TCB_PCK_STEPS 100
+#define TCB_PCK_MAX 0.02
+
+/* Running mean / variance (Welford; Chan et al. to merge). std uses ddof = 0. */
+typedef struct tcb_stat {
+    double n;
+    double mean;
+    double m2;
+} tcb_stat;
+
+void tcb_stat_push(tcb_stat *s, double x);
+void tcb_stat_merge(tcb_stat *into, const tcb_stat *other);
+double tcb_stat_std(const tcb_stat *s);
+
+/* Threshold s of the PCK curve: linspace(0, TCB_PCK_MAX, TCB_PCK_STEPS)[s]. */
+double tcb_pck_threshold(int s);
+
+typedef struct tcb_pair_metrics {
+    tcb_stat sl2;               /* per-vertex Euclidean error */
+    tcb_stat sl2sq;             /* per-vertex squared error */
+    tcb_stat rank;              /* per-vertex normalized rank in [0, 1) */
+    double pck[TCB_PCK_STEPS];  /* fractions */
+    double auc;                 /* mean of pck, in [0, 1] */
+} tcb_pair_metrics;
+
+/* Step 2 of the transfer: idx[k] = nearest GT vertex of frame j to pts[k]. */
+int tcb_project_to_vertices(const float *verts_j, int nv, const float *pts, int n,
+                            int32_t *idx, tcb_error *err);
+
+/* Metrics of one pair from predicted vertex ids (pred[k] ∈ [0, nv)). */
+int tcb_pair_metrics_compute(const float *verts_j, int nv, const int32_t *pred,
+                             tcb_pair_metrics *out, tcb_error *err);
+
+/* Symmetric Chamfer distance of squared nearest-neighbour distances (means). */
+int tcb_chamfer(const float *a, int na, const float *b, int nb, double *out,
+                tcb_error *err);
+
+/* The atlas transfer f = π_Pj ∘ φ_j ∘ φ_i⁻¹ ∘ π_φi over discrete samples
+ * (§5.4 steps 1–2 without the final projection): pred_i and pred_j are the
+ * predicted surface points of frames i and j at the SAME m UV samples; each
+ * src point goes to pred_j[argmin_m |src − pred_i[m]|]. out is [n][3]. */
+int tcb_atlas_transfer(const float *src, int n, const float *pred_i, const float *pred_j,
+                       int m, float *out, tcb_error *err);
+
+/* Everything measured on one (dataset, sequence, method, seed) cell. */
+typedef struct tcb_summary {
+    int n_pairs;
+    tcb_stat sl2, sl2sq, rank;   /* pooled over all vertices of all pairs */
+    tcb_stat auc;                /* over pairs */
+    tcb_stat cd;                 /* over pairs; n = 0 when the method has no reconstruction */
+    double pck[TCB_PCK_STEPS];   /* mean curve over pairs */
+} tcb_summary;
+
+void tcb_summary_init(tcb_summary *s);
+/* cd: the pair's Chamfer distance, or NAN when there is none. */
+void tcb_summary_add_pair(tcb_summary *s, const tcb_pair_metrics *m, double cd);
+void tcb_summary_merge(tcb_summary *into, const tcb_summary *other);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

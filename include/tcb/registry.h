@@ -1,0 +1,26 @@
+/* tcbench — the method registry: built-in methods plus plug-ins loaded by
+ * path. This is the only process-wide mutable state in libtcbench. */
+#ifndef TCB_REGISTRY_H
+#define TCB_REGISTRY_H
+
+#include "tcb/error.h"
+#include "tcb/method.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+const tcb_method_ops *tcb_registry_find(const char *name);
+int tcb_registry_count(void);
+const tcb_method_ops *tcb_registry_get(int k);
+/* Where method k came from: "built-in" or the plug-in's path. */
+const char *tcb_registry_origin(int k);
+
+/* dlopen a plug-in and register its methods. Fails on a missing entry
+ * symbol, a wrong abi_version, an incomplete table or a duplicate name. */
+int tcb_registry_load_plugin(const char *path, tcb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,35 @@
+/* tcbench — reports and regression checks from a results directory.
+ *
+ * Tables are shaped like the paper's: one block per sequence, rows =
+ * methods, columns m_sL2 ×1e3 ↓, rank % ↓, AUC % ↑, CD ×1e3 ↓ as mean ± std,
+ * best in bold, "-" where a method has no reconstruction; a MEAN block per
+ * dataset averages per-sequence means and stds over TEST sequences only
+ * (reference-protocol §5.6). Cells of several seeds pool their pairs. */
+#ifndef TCB_REPORT_H
+#define TCB_REPORT_H
+
+#include <stdio.h>
+
+#include "tcb/error.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Writes <out_dir>/{tables.md, tables.tex, results.csv, pck_<dataset>_<sequence>.png}
+ * (out_dir NULL → <run>/report) and echoes the Markdown tables to `echo` if non-NULL. */
+int tcb_report_write(const char *run_dir, const char *out_dir, FILE *echo, tcb_error *err);
+
+/* Baseline file "tcbench-baseline/1": per (dataset, sequence, method) the four
+ * metrics in table units, plus per-metric tolerances. */
+int tcb_baseline_write(const char *run_dir, const char *baseline_path, tcb_error *err);
+
+/* Compare; prints a diff table to `out`; *n_drift = rows outside tolerance
+ * (missing or extra cells count as drift). */
+int tcb_check(const char *run_dir, const char *baseline_path, FILE *out, int *n_drift,
+              tcb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

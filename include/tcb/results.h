@@ -1,0 +1,84 @@
+/* tcbench — the results store: one JSON file per cell, written atomically.
+ *
+ * Layout of a run directory:
+ *     <run>/config.json                                  the config as run
+ *     <run>/cells/<dataset>/<sequence>/<method>/seed_<s>.json
+ *     <run>/work/<dataset>/<sequence>/<method>/seed_<s>/  method checkpoints
+ *     <run>/report/                                      written by `tcbench report`
+ * A cell file exists only once the cell finished (ok, failed or diverged);
+ * `tcbench run` skips cells whose file exists, so a killed run resumes.
+ *
+ * Cell file format "tcbench-cell/1" (all metric values in raw units:
+ * distances in normalized shape units, rank/auc/pck as fractions):
+ *   { "format", "dataset", "sequence", "role", "method", "method_impl",
+ *     "params": {…}, "seed", "status": "ok"|"failed"|"diverged", "message",
+ *     "git_revision", "tcbench_version",
+ *     "timings": {"load_s", "fit_s", "eval_s"}, "peak_rss_kb",
+ *     "split": {"path", "seed", "n_pairs"},
+ *     "summary": {"n_pairs", "sl2": {"n","mean","m2"}, "sl2sq": {…},
+ *                 "rank": {…}, "auc": {…}, "cd": {…} | null, "pck": [100]},
+ *     "pair_columns": ["i","j","n","sl2","sl2_m2","sl2sq","sl2sq_m2",
+ *                      "rank","rank_m2","auc","cd"],
+ *     "pairs": [[…], …] }                    (cd is null without reconstruction) */
+#ifndef TCB_RESULTS_H
+#define TCB_RESULTS_H
+
+#include <stddef.h>
+
+#include "tcb/error.h"
+#include "tcb/metrics.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TCB_CELL_FORMAT "tcbench-cell/1"
+
+typedef enum tcb_cell_status { TCB_CELL_OK, TCB_CELL_FAILED, TCB_CELL_DIVERGED } tcb_cell_status;
+
+const char *tcb_cell_status_name(tcb_cell_status s);
+
+typedef struct tcb_pair_record {
+    int i, j;
+    tcb_stat sl2, sl2sq, rank; /* over the pair's vertices */
+    double auc;
+    double cd;                 /* NAN when the method has no reconstruction */
+} tcb_pair_record;
+
+typedef struct tcb_cell_result {
+    char dataset[64];
+    char sequence[128];
+    char role[16];             /* "train" | "validation" | "test" */
+    char method[64];           /* the config's label for the method */
+    char method_impl[64];      /* the registered method name */
+    char *params_json;         /* malloc'ed, compact JSON object */
+    int seed;
+    tcb_cell_status status;
+    char message[TCB_ERRMSG_MAX];
+    char git_revision[64];
+    double load_s, fit_s, eval_s;
+    long peak_rss_kb;
+    char split_path[4096];
+    unsigned long long split_seed;
+    int n_pairs;
+    tcb_pair_record *pairs;    /* malloc'ed [n_pairs] */
+    tcb_summary summary;
+} tcb_cell_result;
+
+/* <run>/cells/<dataset>/<sequence>/<method>/seed_<seed>.json */
+int tcb_cell_path(char *out, size_t size, const char *run_dir, const char *dataset,
+                  const char *sequence, const char *method, int seed, tcb_error *err);
+
+int tcb_cell_save(const char *path, const tcb_cell_result *c, tcb_error *err);
+/* Validates format and fields; errors name the file and key. */
+int tcb_cell_load(const char *path, tcb_cell_result *out, tcb_error *err);
+void tcb_cell_free(tcb_cell_result *c);
+
+/* Every cell file under <run>/cells, sorted by (dataset, sequence, method, seed).
+ * *cells is malloc'ed; free each with tcb_cell_free, then the array. */
+int tcb_results_scan(const char *run_dir, tcb_cell_result **cells, int *n, tcb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

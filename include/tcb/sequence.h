@@ -1,0 +1,113 @@
+/* tcbench — a deforming-shape sequence: K frames of one mesh topology.
+ *
+ * Vertex k is the same surface point in every frame, so vertex ids are the
+ * ground-truth correspondences. After loading, a sequence is normalized
+ * (reference-protocol §1.3) and carries per frame a pool of area-uniform
+ * surface samples from which methods draw their input clouds (§1.2).
+ *
+ * Ownership: a tcb_sequence owns all its arrays; tcb_sequence_free releases
+ * them. Methods receive `const tcb_sequence *` and must not keep pointers
+ * into it beyond `destroy`. */
+#ifndef TCB_SEQUENCE_H
+#define TCB_SEQUENCE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "tcb/error.h"
+#include "tcb/rng.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TCB_NAME_MAX 128
+#define TCB_DEFAULT_POOL_SIZE 10000
+#define TCB_DEFAULT_INPUT_POINTS 2500
+
+typedef enum tcb_normalization {
+    TCB_NORM_NONE = 0,        /* raw coordinates (DFAUST) */
+    TCB_NORM_FIRST_FRAME = 1, /* ANIM: centre on frame 0's vertex centroid, divide by its largest bbox extent */
+    TCB_NORM_PER_FRAME = 2    /* AMA-like: each frame centred on its own surface centroid, no scaling */
+} tcb_normalization;
+
+typedef struct tcb_sequence {
+    char name[TCB_NAME_MAX];
+    int n_frames;
+    int n_verts;
+    int n_faces;
+    float *verts;       /* [n_frames][n_verts][3] GT vertices, normalized */
+    int32_t *faces;     /* [n_faces][3] triangles shared by every frame */
+    double *areas;      /* [n_frames] GT surface area, normalized units */
+    int pool_size;      /* samples per frame; 0 until pools are drawn */
+    float *pools;       /* [n_frames][pool_size][3] area-uniform samples */
+    tcb_normalization norm;
+    double norm_scale;  /* FIRST_FRAME: the divisor; 1 otherwise */
+    double *norm_shift; /* [n_frames][3] subtracted before scaling */
+} tcb_sequence;
+
+static inline const float *tcb_seq_frame(const tcb_sequence *s, int f)
+{
+    return s->verts + (size_t)f * (size_t)s->n_verts * 3;
+}
+
+static inline const float *tcb_seq_pool(const tcb_sequence *s, int f)
+{
+    return s->pools + (size_t)f * (size_t)s->pool_size * 3;
+}
+
+/* Raw frames from a directory of OBJ files, ordered by the (last) number in
+ * each file name. Frames whose vertex count or faces differ from the first
+ * frame are an error naming both files. Fewer than two frames is an error. */
+int tcb_sequence_read_objdir(const char *dir, tcb_sequence *out, tcb_error *err);
+
+/* Allocate an empty sequence with the given sizes (verts/faces uninitialised). */
+int tcb_sequence_alloc(tcb_sequence *s, const char *name, int n_frames, int n_verts,
+                       int n_faces, tcb_error *err);
+
+/* Apply a normalization in place (to raw vertices) and compute areas. */
+int tcb_sequence_normalize(tcb_sequence *s, tcb_normalization mode, tcb_error *err);
+
+/* Draw pool_size area-uniform samples per frame from a stream seeded by
+ * (seed, sequence name). Deterministic. */
+int tcb_sequence_sample_pools(tcb_sequence *s, int pool_size, uint64_t seed,
+                              tcb_error *err);
+
+/* n input points from frame f's pool: without replacement (a random
+ * permutation's first n, as ANIM) or with replacement (AMA, DFAUST). */
+int tcb_sequence_draw_points(const tcb_sequence *s, int f, int n, int with_replacement,
+                             tcb_rng *rng, float *out, tcb_error *err);
+
+/* Write every frame as <dir>/mesh_NNNN.obj (atomically, one file each). */
+int tcb_sequence_write_objdir(const tcb_sequence *s, const char *dir, tcb_error *err);
+
+void tcb_sequence_free(tcb_sequence *s);
+
+/* ---- Loading with a binary cache ------------------------------------- */
+
+typedef struct tcb_load_opts {
+    tcb_normalization norm;
+    int pool_size;         /* TCB_DEFAULT_POOL_SIZE */
+    uint64_t pool_seed;
+    const char *cache_dir; /* NULL: no cache */
+} tcb_load_opts;
+
+/* Read an OBJ directory, normalize and sample pools; with a cache_dir the
+ * result is stored as HDF5 and later loads skip parsing. A cache entry is
+ * reused only when its recorded source (file names, sizes, mtimes), options
+ * and format version all match. */
+int tcb_sequence_load_objdir(const char *dir, const char *name, const tcb_load_opts *opts,
+                             tcb_sequence *out, tcb_error *err);
+
+/* The HDF5 cache file itself (also usable as an exchange format). `key` is an
+ * opaque string that must match on load; a mismatch returns TCB_ERR_UNSUPPORTED
+ * ("stale") so the caller re-parses. */
+int tcb_sequence_cache_save(const char *path, const tcb_sequence *s, const char *key,
+                            tcb_error *err);
+int tcb_sequence_cache_load(const char *path, const char *key, tcb_sequence *out,
+                            tcb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

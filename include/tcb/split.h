@@ -1,0 +1,57 @@
+/* tcbench — common evaluation splits and training-pair samplers.
+ *
+ * A split file is written once per sequence and then reused, so every method
+ * is scored on the identical 500 pairs (i, j), i ≠ j (reference-protocol
+ * §5.2; the authors drew fresh unseeded pairs per run, we fix them). */
+#ifndef TCB_SPLIT_H
+#define TCB_SPLIT_H
+
+#include <stdint.h>
+
+#include "tcb/error.h"
+#include "tcb/rng.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TCB_DEFAULT_EVAL_PAIRS 500
+
+typedef enum tcb_role { TCB_ROLE_TRAIN, TCB_ROLE_VALIDATION, TCB_ROLE_TEST } tcb_role;
+
+const char *tcb_role_name(tcb_role role);
+int tcb_role_parse(const char *name, tcb_role *out); /* 0 on success, -1 unknown */
+
+typedef struct tcb_split {
+    char dataset[64];
+    char sequence[128];
+    tcb_role role;
+    int n_frames;
+    uint64_t seed;
+    int n_pairs;
+    int32_t *pairs; /* [n_pairs][2]: i uniform over frames, j uniform over the others */
+} tcb_split;
+
+int tcb_split_make(const char *dataset, const char *sequence, tcb_role role, int n_frames,
+                   int n_pairs, uint64_t seed, tcb_split *out, tcb_error *err);
+int tcb_split_save(const char *path, const tcb_split *s, tcb_error *err); /* JSON, atomic */
+int tcb_split_load(const char *path, tcb_split *out, tcb_error *err);
+/* Load `path` if it exists and agrees with (sequence, role, n_frames), else
+ * make and save it. Disagreement is an error naming the file and the field. */
+int tcb_split_obtain(const char *path, const char *dataset, const char *sequence,
+                     tcb_role role, int n_frames, int n_pairs, uint64_t seed,
+                     tcb_split *out, tcb_error *err);
+void tcb_split_free(tcb_split *s);
+
+/* Training-pair sampling (§1.4): given i, draw j ≠ i.
+ *   NEIGHBORS:  1 ≤ |i − j| ≤ delta, clipped to [0, n_frames)
+ *   RANDOM, WITHIN_SEQ: uniform over the other frames (one sequence) */
+typedef enum tcb_pair_mode { TCB_PAIRS_NEIGHBORS, TCB_PAIRS_RANDOM, TCB_PAIRS_WITHIN_SEQ } tcb_pair_mode;
+
+int tcb_pair_mode_parse(const char *name, tcb_pair_mode *out); /* 0 ok, -1 unknown */
+int tcb_pair_sample(tcb_pair_mode mode, int delta, int n_frames, int i, tcb_rng *rng);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,10 @@
+/* The built-in methods' tables, listed once in methods/registry.c. */
+#ifndef TCB_METHODS_BUILTIN_H
+#define TCB_METHODS_BUILTIN_H
+
+#include "tcb/method.h"
+
+extern const tcb_method_ops tcb_method_oracle;
+extern const tcb_method_ops tcb_method_nearest;
+
+#endif

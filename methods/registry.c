@@ -1,0 +1,119 @@
+/* The method registry: the built-in tables plus plug-ins loaded by path.
+ * The only process-wide mutable state in libtcbench (the brief allows it
+ * here); it grows only, and plug-ins stay loaded for the process lifetime
+ * because their tables and code are referenced until exit. */
+#include "tcb/registry.h"
+
+#include <dlfcn.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "methods/builtin.h"
+
+#define MAX_METHODS 256
+
+static const tcb_method_ops *const builtins[] = {
+    &tcb_method_oracle,
+    &tcb_method_nearest,
+};
+#define N_BUILTINS ((int)(sizeof builtins / sizeof builtins[0]))
+
+typedef struct plugin_entry {
+    const tcb_method_ops *ops;
+    char *origin; /* the plug-in's path */
+} plugin_entry;
+
+static plugin_entry plugins[MAX_METHODS];
+static int n_plugins;
+
+int tcb_registry_count(void) { return N_BUILTINS + n_plugins; }
+
+const tcb_method_ops *tcb_registry_get(int k)
+{
+    if (k < 0 || k >= tcb_registry_count()) return NULL;
+    return k < N_BUILTINS ? builtins[k] : plugins[k - N_BUILTINS].ops;
+}
+
+const char *tcb_registry_origin(int k)
+{
+    if (k < 0 || k >= tcb_registry_count()) return NULL;
+    return k < N_BUILTINS ? "built-in" : plugins[k - N_BUILTINS].origin;
+}
+
+const tcb_method_ops *tcb_registry_find(const char *name)
+{
+    for (int k = 0; k < tcb_registry_count(); k++)
+        if (strcmp(tcb_registry_get(k)->name, name) == 0) return tcb_registry_get(k);
+    return NULL;
+}
+
+static int valid_name(const char *name)
+{
+    if (!name || !*name || strlen(name) >= 64) return 0;
+    for (const char *p = name; *p; p++)
+        if (!((*p >= 'a' && *p <= 'z') || (*p >= '0' && *p <= '9') || *p == '_' || *p == '-')) return 0;
+    return 1;
+}
+
+/* A table must be complete enough for the harness to call it blindly. */
+static int check_table(const tcb_method_ops *ops, const char *path, tcb_error *err)
+{
+    if (!ops) return tcb_fail(err, TCB_ERR_INPUT, "%s: plug-in returned a NULL method table", path);
+    if (ops->abi_version != TCB_METHOD_ABI_VERSION)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: method ABI version %d, this tcbench needs %d (rebuild the plug-in)",
+                        path, ops->abi_version, TCB_METHOD_ABI_VERSION);
+    if (!valid_name(ops->name))
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: method name '%s' must be 1-63 characters of [a-z0-9_-]", path,
+                        ops->name ? ops->name : "(null)");
+    if (!ops->create || !ops->fit || !ops->transfer || !ops->destroy)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: method '%s' lacks one of create, fit, transfer, destroy", path,
+                        ops->name);
+    if (!ops->save != !ops->load)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: method '%s' must define both save and load, or neither", path,
+                        ops->name);
+    if (tcb_registry_find(ops->name))
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: a method named '%s' is already registered", path, ops->name);
+    return TCB_OK;
+}
+
+int tcb_registry_load_plugin(const char *path, tcb_error *err)
+{
+    /* dlopen searches the library path for names without a slash; a plug-in
+     * is always named by path, so make relative names explicit. */
+    char full[4096];
+    snprintf(full, sizeof full, "%s%s", strchr(path, '/') ? "" : "./", path);
+    for (int k = 0; k < n_plugins; k++)
+        if (strcmp(plugins[k].origin, full) == 0) return TCB_OK; /* already loaded */
+    void *handle = dlopen(full, RTLD_NOW | RTLD_LOCAL);
+    if (!handle) return tcb_fail(err, TCB_ERR_INPUT, "%s: cannot load plug-in: %s", path, dlerror());
+    tcb_plugin_entry_fn entry;
+    *(void **)&entry = dlsym(handle, TCB_PLUGIN_ENTRY); /* POSIX-sanctioned cast of a data pointer */
+    if (!entry) {
+        dlclose(handle);
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: not a tcbench plug-in (no symbol %s)", path, TCB_PLUGIN_ENTRY);
+    }
+    int count = 0;
+    const tcb_method_ops *const *tables = entry(&count);
+    if (!tables || count <= 0 || n_plugins + count > MAX_METHODS) {
+        dlclose(handle);
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: plug-in offers %d methods (expected 1..%d)", path, count,
+                        MAX_METHODS - n_plugins);
+    }
+    for (int k = 0; k < count; k++) {
+        int rc = check_table(tables[k], path, err);
+        for (int m = 0; !rc && m < k; m++)
+            if (strcmp(tables[m]->name, tables[k]->name) == 0)
+                rc = tcb_fail(err, TCB_ERR_INPUT, "%s: method '%s' is listed twice", path, tables[k]->name);
+        if (rc) {
+            dlclose(handle);
+            return rc;
+        }
+    }
+    for (int k = 0; k < count; k++) {
+        plugins[n_plugins].ops = tables[k];
+        plugins[n_plugins].origin = strdup(full);
+        n_plugins++;
+    }
+    return TCB_OK;
+}

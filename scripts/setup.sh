@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Install the Debian packages tcbench needs, if any are missing. Safe to rerun:
+# it only calls apt-get when something is absent.
+set -euo pipefail
+
+packages=(
+  gcc make cmake pkg-config git           # toolchain
+  libcjson-dev                            # configs and results (JSON)
+  libflann-dev liblz4-dev                 # k-NN (FLANN's C API; its headers want lz4)
+  libhdf5-dev                             # binary sequence cache
+  libcairo2-dev fonts-dejavu-core         # PNG plots with text
+  libcmocka-dev                           # unit-test framework
+  python3                                 # integration tests compare JSON results
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+echo "tcbench setup: installing ${missing[*]}" >&2
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "tcbench setup: need root (or sudo) to install: ${missing[*]}" >&2; exit 1; }
+  sudo="sudo"
+fi
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

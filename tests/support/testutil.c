@@ -1,0 +1,48 @@
+#define _XOPEN_SOURCE 700 /* nftw */
+#include "testutil.h"
+
+#include <ftw.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+void tu_make_tmpdir(char *out, size_t size)
+{
+    const char *base = getenv("TMPDIR");
+    if (!base || !*base) base = "/tmp";
+    if ((size_t)snprintf(out, size, "%s/tcbench-test-XXXXXX", base) >= size || !mkdtemp(out)) {
+        fprintf(stderr, "cannot create a temporary directory under %s\n", base);
+        abort();
+    }
+}
+
+void tu_write_text(const char *dir, const char *name, const char *text, char *out, size_t size)
+{
+    if ((size_t)snprintf(out, size, "%s/%s", dir, name) >= size) abort();
+    FILE *f = fopen(out, "wb");
+    if (!f) {
+        perror(out);
+        abort();
+    }
+    fputs(text, f);
+    fclose(f);
+}
+
+static int remove_entry(const char *path, const struct stat *st, int flag, struct FTW *ftw)
+{
+    (void)st, (void)flag, (void)ftw;
+    return remove(path);
+}
+
+void tu_remove_tree(const char *dir)
+{
+    nftw(dir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+}
+
+const char *tu_shared_data(void)
+{
+    struct stat st;
+    return stat(TCB_SHARED_DATA, &st) == 0 && S_ISDIR(st.st_mode) ? TCB_SHARED_DATA : NULL;
+}
