@@ -66,6 +66,8 @@ int tcb_temp_path_for(const char *path, char *tmp, size_t tmp_size, tcb_error *e
     if (tcb_path_join(tmp, tmp_size, err, "%s.tmp-XXXXXX", path)) return TCB_ERR_INPUT;
     int fd = mkstemp(tmp);
     if (fd < 0) return tcb_fail(err, TCB_ERR_IO, "%s: cannot create temporary file: %s", tmp, strerror(errno));
+    /* mkstemp creates 0600; results, reports and caches are meant to be shared. */
+    fchmod(fd, 0644);
     close(fd);
     return TCB_OK;
 }

@@ -33,6 +33,7 @@ void tcb_report_log(const tcb_reporter *r, tcb_log_level level, const char *fmt,
 
 #define BAR_WIDTH 30
 #define TTY_REDRAW_S 0.1 /* at most 10 redraws a second */
+#define PLAIN_EVERY_S 10.0
 
 static void draw_bar(tcb_term_progress *tp, double done, double total)
 {
@@ -55,7 +56,6 @@ static void term_progress(void *ctx, double done, double total, const char *labe
     int new_label = strncmp(tp->label, label ? label : "", sizeof tp->label - 1) != 0;
     if (new_label) {
         snprintf(tp->label, sizeof tp->label, "%s", label ? label : "");
-        tp->last_decile = -1;
     }
     double now = tcb_now_seconds();
     int finished = done >= total;
@@ -66,12 +66,13 @@ static void term_progress(void *ctx, double done, double total, const char *labe
         }
         return;
     }
-    /* Not a terminal (a log file): one plain line per 10 % step. */
-    int decile = total > 0 ? (int)(10 * done / total) : 10;
-    if (decile > tp->last_decile) {
-        fprintf(tp->out, "%s: %d%% (%.0f/%.0f)\n", tp->label, 10 * decile, done, total);
+    /* Not a terminal (a log file): a line when a task starts, when it ends,
+     * and at most every PLAIN_EVERY_S in between. */
+    if (new_label || finished || now - tp->last_emit_s >= PLAIN_EVERY_S) {
+        fprintf(tp->out, "%s: %.0f%% (%.0f/%.0f)\n", tp->label, total > 0 ? 100 * done / total : 100.0, done,
+                total);
         fflush(tp->out);
-        tp->last_decile = decile;
+        tp->last_emit_s = now;
     }
 }
 
@@ -95,7 +96,6 @@ void tcb_term_progress_init(tcb_term_progress *tp, FILE *out, int quiet)
         quiet = ci && *ci && strcmp(ci, "0") != 0 && strcmp(ci, "false") != 0;
     }
     tp->quiet = quiet;
-    tp->last_decile = -1;
 }
 
 tcb_reporter tcb_term_progress_reporter(tcb_term_progress *tp)

@@ -1,8 +1,12 @@
 /* tcbench — exact nearest-neighbour search in 3-D.
  *
  * Brute force (SIMD-friendly, exact) below a measured size, FLANN's
- * single kd-tree with unlimited checks (also exact) above it. Ties are
- * broken towards the lowest index so results are reproducible. */
+ * single kd-tree with unlimited checks (also exact) above it. Squared
+ * distances are the float expression (dx² + dy²) + dz² in both backends, so
+ * a query's NN distance is bit-identical whichever backend answers it.
+ * Brute force breaks exact ties towards the lowest index; the kd-tree breaks
+ * them in its own (deterministic) traversal order, so on exact ties only the
+ * index may differ. k-NN rows are sorted by (distance, index). */
 #ifndef TCB_NN_H
 #define TCB_NN_H
 
@@ -17,7 +21,8 @@ extern "C" {
 typedef struct tcb_nn tcb_nn;
 
 /* Index over n points (xyz floats, row-major). The points are copied.
- * Non-finite coordinates are an error (TCB_ERR_NUMERIC). */
+ * Coordinates that are not finite or beyond ±1e18 (where squared distances
+ * could overflow) are an error (TCB_ERR_NUMERIC), for queries too. */
 int tcb_nn_build(const float *pts, int n, tcb_nn **out, tcb_error *err);
 
 /* The same with the search strategy forced (benchmarks and tests); AUTO is

@@ -2,7 +2,8 @@
  *
  * Methods and the runner report through a tcb_reporter (two callbacks and a
  * context), never by printing. The terminal implementation draws a bar on a
- * TTY, prints occasional plain lines when stderr is not a TTY, and prints
+ * TTY, prints a plain line when a task starts and ends (and every 10 s in
+ * between) when the output is not a TTY, and prints
  * nothing but warnings when quiet (CI=true or --quiet). */
 #ifndef TCB_PROGRESS_H
 #define TCB_PROGRESS_H
@@ -34,7 +35,6 @@ typedef struct tcb_term_progress {
     int is_tty;
     int quiet;
     double last_emit_s;   /* monotonic time of the last redraw / line */
-    int last_decile;      /* non-TTY: last 10 % step printed for the label */
     char label[128];
 } tcb_term_progress;
 

@@ -44,6 +44,11 @@ typedef struct tcb_sequence {
     tcb_normalization norm;
     double norm_scale;  /* FIRST_FRAME: the divisor; 1 otherwise */
     double *norm_shift; /* [n_frames][3] subtracted before scaling */
+    /* The dataset's input protocol (§1.2), set by the harness from the
+     * config: a method's input cloud is input_points draws from a pool,
+     * with or without replacement (see tcb_sequence_draw_points). */
+    int input_points;
+    int draw_with_replacement;
 } tcb_sequence;
 
 static inline const float *tcb_seq_frame(const tcb_sequence *s, int f)

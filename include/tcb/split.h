@@ -36,8 +36,10 @@ int tcb_split_make(const char *dataset, const char *sequence, tcb_role role, int
                    int n_pairs, uint64_t seed, tcb_split *out, tcb_error *err);
 int tcb_split_save(const char *path, const tcb_split *s, tcb_error *err); /* JSON, atomic */
 int tcb_split_load(const char *path, tcb_split *out, tcb_error *err);
-/* Load `path` if it exists and agrees with (sequence, role, n_frames), else
- * make and save it. Disagreement is an error naming the file and the field. */
+/* Load `path` if it exists and agrees with the request (dataset, sequence,
+ * role, n_frames, n_pairs, seed), else make and save it. Disagreement is an
+ * error (TCB_ERR_INPUT) naming the file and the first differing field; the
+ * pairs of an existing file are used as stored. */
 int tcb_split_obtain(const char *path, const char *dataset, const char *sequence,
                      tcb_role role, int n_frames, int n_pairs, uint64_t seed,
                      tcb_split *out, tcb_error *err);
@@ -45,7 +47,9 @@ void tcb_split_free(tcb_split *s);
 
 /* Training-pair sampling (§1.4): given i, draw j ≠ i.
  *   NEIGHBORS:  1 ≤ |i − j| ≤ delta, clipped to [0, n_frames)
- *   RANDOM, WITHIN_SEQ: uniform over the other frames (one sequence) */
+ *   RANDOM, WITHIN_SEQ: uniform over the other frames (one sequence)
+ * Returns −1 when no j exists (n_frames < 2, i outside [0, n_frames), or
+ * delta < 1 for NEIGHBORS): the caller reports it. */
 typedef enum tcb_pair_mode { TCB_PAIRS_NEIGHBORS, TCB_PAIRS_RANDOM, TCB_PAIRS_WITHIN_SEQ } tcb_pair_mode;
 
 int tcb_pair_mode_parse(const char *name, tcb_pair_mode *out); /* 0 ok, -1 unknown */

@@ -1,0 +1,385 @@
+/* HDF5 cache of a loaded sequence, so benchmark runs skip OBJ parsing.
+ *
+ * Layout (one file per sequence and options):
+ *   /verts      float32 [F][V][3]     /faces   int32 [NF][3]
+ *   /areas      float64 [F]           /norm_shift float64 [F][3]
+ *   /pools      float32 [F][P][3]     (absent when P = 0)
+ *   attributes on /: format_version, key, name, norm, norm_scale.
+ * The file is written under a temporary name and renamed into place. */
+#include <errno.h>
+#include <fcntl.h>
+#include <hdf5.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "datasets/objdir.h"
+#include "tcb/fsutil.h"
+#include "tcb/sequence.h"
+
+/* Bump when the layout or the meaning of any field changes. */
+#define CACHE_FORMAT_VERSION 1
+
+/* HDF5 prints its error stack by default; library code must not print, so
+ * every entry point silences it and restores the caller's handler after. */
+typedef struct h5_quiet {
+    H5E_auto2_t func;
+    void *data;
+} h5_quiet;
+
+static void quiet_begin(h5_quiet *q)
+{
+    H5Eget_auto2(H5E_DEFAULT, &q->func, &q->data);
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+}
+
+static void quiet_end(const h5_quiet *q) { H5Eset_auto2(H5E_DEFAULT, q->func, q->data); }
+
+/* ---- writing ---------------------------------------------------------- */
+
+static int write_array(hid_t file, const char *name, hid_t file_type, hid_t mem_type, int rank,
+                       const hsize_t *dims, const void *data)
+{
+    hid_t space = H5Screate_simple(rank, dims, NULL);
+    hid_t ds = space < 0 ? -1 : H5Dcreate2(file, name, file_type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    herr_t st = ds < 0 ? -1 : H5Dwrite(ds, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
+    if (ds >= 0 && H5Dclose(ds) < 0) st = -1;
+    if (space >= 0) H5Sclose(space);
+    return st < 0 ? -1 : 0;
+}
+
+static int write_attr(hid_t obj, const char *name, hid_t file_type, hid_t mem_type, const void *value)
+{
+    hid_t space = H5Screate(H5S_SCALAR);
+    hid_t a = space < 0 ? -1 : H5Acreate2(obj, name, file_type, space, H5P_DEFAULT, H5P_DEFAULT);
+    herr_t st = a < 0 ? -1 : H5Awrite(a, mem_type, value);
+    if (a >= 0 && H5Aclose(a) < 0) st = -1;
+    if (space >= 0) H5Sclose(space);
+    return st < 0 ? -1 : 0;
+}
+
+static int write_attr_string(hid_t obj, const char *name, const char *value)
+{
+    hid_t type = H5Tcopy(H5T_C_S1);
+    if (type < 0) return -1;
+    int rc = H5Tset_size(type, strlen(value) + 1) < 0 ? -1 : write_attr(obj, name, type, type, value);
+    H5Tclose(type);
+    return rc;
+}
+
+static int write_contents(hid_t file, const tcb_sequence *s, const char *key)
+{
+    const int version = CACHE_FORMAT_VERSION, norm = (int)s->norm;
+    hsize_t F = (hsize_t)s->n_frames, V = (hsize_t)s->n_verts, P = (hsize_t)s->pool_size;
+    hsize_t verts_dims[3] = {F, V, 3}, faces_dims[2] = {(hsize_t)s->n_faces, 3};
+    hsize_t shift_dims[2] = {F, 3}, pool_dims[3] = {F, P, 3};
+    int bad = write_attr(file, "format_version", H5T_STD_I32LE, H5T_NATIVE_INT, &version) ||
+              write_attr_string(file, "key", key) || write_attr_string(file, "name", s->name) ||
+              write_attr(file, "norm", H5T_STD_I32LE, H5T_NATIVE_INT, &norm) ||
+              write_attr(file, "norm_scale", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &s->norm_scale) ||
+              write_array(file, "verts", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, 3, verts_dims, s->verts) ||
+              write_array(file, "faces", H5T_STD_I32LE, H5T_NATIVE_INT32, 2, faces_dims, s->faces) ||
+              write_array(file, "areas", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, &F, s->areas) ||
+              write_array(file, "norm_shift", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, shift_dims, s->norm_shift);
+    if (!bad && s->pool_size > 0)
+        bad = write_array(file, "pools", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, 3, pool_dims, s->pools);
+    return bad ? -1 : 0;
+}
+
+/* HDF5 does not fsync; a crash must not publish a half-written cache. */
+static int fsync_path(const char *path)
+{
+    int fd = open(path, O_RDONLY);
+    if (fd < 0) return -1;
+    int rc = fsync(fd);
+    close(fd);
+    return rc;
+}
+
+int tcb_sequence_cache_save(const char *path, const tcb_sequence *s, const char *key, tcb_error *err)
+{
+    if (!s->areas || !s->norm_shift)
+        return tcb_fail(err, TCB_ERR_INTERNAL, "sequence %s: normalize before caching", s->name);
+    char tmp[TCB_PATH_MAX];
+    int rc = tcb_temp_path_for(path, tmp, sizeof tmp, err);
+    if (rc) return rc;
+    h5_quiet q;
+    quiet_begin(&q);
+    /* 1.8+ object headers: the key attribute may exceed the 64 KiB limit of
+     * the oldest format on long sequences. */
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    hid_t file = fapl < 0 || H5Pset_libver_bounds(fapl, H5F_LIBVER_V18, H5F_LIBVER_LATEST) < 0
+                     ? -1
+                     : H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    int bad = file < 0 || write_contents(file, s, key) != 0;
+    if (file >= 0 && H5Fclose(file) < 0) bad = 1;
+    if (fapl >= 0) H5Pclose(fapl);
+    quiet_end(&q);
+    if (bad || fsync_path(tmp) != 0) {
+        unlink(tmp);
+        return tcb_fail(err, TCB_ERR_IO, "%s: cannot write sequence cache", path);
+    }
+    return tcb_publish(tmp, path, err);
+}
+
+/* ---- reading ---------------------------------------------------------- */
+
+/* A scalar numeric attribute converted to mem_type. */
+static int read_attr(hid_t obj, const char *name, hid_t mem_type, void *out)
+{
+    if (H5Aexists(obj, name) <= 0) return -1;
+    hid_t a = H5Aopen(obj, name, H5P_DEFAULT);
+    if (a < 0) return -1;
+    hid_t space = H5Aget_space(a);
+    int ok = space >= 0 && H5Sget_simple_extent_npoints(space) == 1 && H5Aread(a, mem_type, out) >= 0;
+    if (space >= 0) H5Sclose(space);
+    H5Aclose(a);
+    return ok ? 0 : -1;
+}
+
+/* A fixed-length string attribute, malloc'ed and NUL-terminated. */
+static char *read_attr_string(hid_t obj, const char *name)
+{
+    if (H5Aexists(obj, name) <= 0) return NULL;
+    hid_t a = H5Aopen(obj, name, H5P_DEFAULT);
+    if (a < 0) return NULL;
+    hid_t type = H5Aget_type(a), space = H5Aget_space(a);
+    char *buf = NULL;
+    if (type >= 0 && space >= 0 && H5Tget_class(type) == H5T_STRING && H5Tis_variable_str(type) == 0 &&
+        H5Sget_simple_extent_npoints(space) == 1) {
+        size_t size = H5Tget_size(type);
+        buf = calloc(size + 1, 1);
+        if (buf && H5Aread(a, type, buf) < 0) {
+            free(buf);
+            buf = NULL;
+        }
+    }
+    if (space >= 0) H5Sclose(space);
+    if (type >= 0) H5Tclose(type);
+    H5Aclose(a);
+    return buf;
+}
+
+/* dims[0..rank) of dataset `name`; -1 when absent or of another rank. */
+static int array_dims(hid_t file, const char *name, int rank, hsize_t *dims)
+{
+    if (H5Lexists(file, name, H5P_DEFAULT) <= 0) return -1;
+    hid_t ds = H5Dopen2(file, name, H5P_DEFAULT);
+    if (ds < 0) return -1;
+    hid_t space = H5Dget_space(ds);
+    int ok = space >= 0 && H5Sget_simple_extent_ndims(space) == rank &&
+             H5Sget_simple_extent_dims(space, dims, NULL) == rank;
+    if (space >= 0) H5Sclose(space);
+    H5Dclose(ds);
+    return ok ? 0 : -1;
+}
+
+/* Reads dataset `name` into buf after checking it has exactly `dims`. */
+static int read_array(hid_t file, const char *name, hid_t mem_type, int rank, const hsize_t *dims, void *buf)
+{
+    hsize_t got[3];
+    if (array_dims(file, name, rank, got) != 0) return -1;
+    for (int d = 0; d < rank; d++)
+        if (got[d] != dims[d]) return -1;
+    hid_t ds = H5Dopen2(file, name, H5P_DEFAULT);
+    if (ds < 0) return -1;
+    herr_t st = H5Dread(ds, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf);
+    H5Dclose(ds);
+    return st < 0 ? -1 : 0;
+}
+
+static int corrupt(const char *path, const char *what, tcb_error *err)
+{
+    return tcb_fail(err, TCB_ERR_INPUT, "%s: not a valid tcbench sequence cache (%s)", path, what);
+}
+
+/* Format version and key, before any large read. */
+static int check_key(hid_t file, const char *path, const char *key, tcb_error *err)
+{
+    int version;
+    if (read_attr(file, "format_version", H5T_NATIVE_INT, &version) != 0)
+        return corrupt(path, "no format_version", err);
+    if (version != CACHE_FORMAT_VERSION)
+        return tcb_fail(err, TCB_ERR_UNSUPPORTED, "%s: stale cache (format %d, expected %d)", path, version,
+                        CACHE_FORMAT_VERSION);
+    char *stored = read_attr_string(file, "key");
+    if (!stored) return corrupt(path, "no key", err);
+    int same = strcmp(stored, key) == 0;
+    free(stored);
+    return same ? TCB_OK : tcb_fail(err, TCB_ERR_UNSUPPORTED, "%s: stale cache (source or options changed)", path);
+}
+
+/* Sizes from the verts/faces/pools shapes, then allocation of everything. */
+static int alloc_from_shapes(hid_t file, const char *path, tcb_sequence *out, tcb_error *err)
+{
+    hsize_t vd[3], fd[2], pd[3] = {0, 0, 3};
+    if (array_dims(file, "verts", 3, vd) != 0 || array_dims(file, "faces", 2, fd) != 0)
+        return corrupt(path, "verts or faces missing", err);
+    int has_pools = H5Lexists(file, "pools", H5P_DEFAULT) > 0;
+    if (has_pools && array_dims(file, "pools", 3, pd) != 0) return corrupt(path, "bad pools", err);
+    if (vd[0] > INT32_MAX || vd[1] > INT32_MAX / 3 || vd[2] != 3 || fd[0] > INT32_MAX / 3 || fd[1] != 3 ||
+        pd[1] > INT32_MAX / 3 || pd[2] != 3 || (has_pools && (pd[0] != vd[0] || pd[1] == 0)))
+        return corrupt(path, "inconsistent array shapes", err);
+    char *name = read_attr_string(file, "name");
+    if (!name) return corrupt(path, "no name", err);
+    int rc = tcb_sequence_alloc(out, name, (int)vd[0], (int)vd[1], (int)fd[0], err);
+    free(name);
+    if (rc) return rc == TCB_ERR_NOMEM ? rc : corrupt(path, "bad sizes or name", err);
+    out->pool_size = (int)pd[1];
+    out->areas = malloc((size_t)out->n_frames * sizeof *out->areas);
+    out->norm_shift = malloc((size_t)out->n_frames * 3 * sizeof *out->norm_shift);
+    out->pools = has_pools ? malloc((size_t)out->n_frames * (size_t)out->pool_size * 3 * sizeof(float)) : NULL;
+    if (!out->areas || !out->norm_shift || (has_pools && !out->pools))
+        return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", path);
+    return TCB_OK;
+}
+
+static int read_contents(hid_t file, const char *path, tcb_sequence *out, tcb_error *err)
+{
+    int rc = alloc_from_shapes(file, path, out, err);
+    if (rc) return rc;
+    hsize_t F = (hsize_t)out->n_frames, V = (hsize_t)out->n_verts, P = (hsize_t)out->pool_size;
+    hsize_t verts_dims[3] = {F, V, 3}, faces_dims[2] = {(hsize_t)out->n_faces, 3};
+    hsize_t shift_dims[2] = {F, 3}, pool_dims[3] = {F, P, 3};
+    int norm;
+    if (read_attr(file, "norm", H5T_NATIVE_INT, &norm) != 0 ||
+        read_attr(file, "norm_scale", H5T_NATIVE_DOUBLE, &out->norm_scale) != 0 ||
+        read_array(file, "verts", H5T_NATIVE_FLOAT, 3, verts_dims, out->verts) != 0 ||
+        read_array(file, "faces", H5T_NATIVE_INT32, 2, faces_dims, out->faces) != 0 ||
+        read_array(file, "areas", H5T_NATIVE_DOUBLE, 1, &F, out->areas) != 0 ||
+        read_array(file, "norm_shift", H5T_NATIVE_DOUBLE, 2, shift_dims, out->norm_shift) != 0 ||
+        (out->pools && read_array(file, "pools", H5T_NATIVE_FLOAT, 3, pool_dims, out->pools) != 0))
+        return corrupt(path, "unreadable attribute or array", err);
+    if (norm < TCB_NORM_NONE || norm > TCB_NORM_PER_FRAME) return corrupt(path, "unknown normalization", err);
+    out->norm = (tcb_normalization)norm;
+    /* Bad ids would turn into out-of-bounds reads far from here. */
+    for (size_t i = 0; i < 3 * (size_t)out->n_faces; i++)
+        if (out->faces[i] < 0 || out->faces[i] >= out->n_verts) return corrupt(path, "face index out of range", err);
+    return TCB_OK;
+}
+
+int tcb_sequence_cache_load(const char *path, const char *key, tcb_sequence *out, tcb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->input_points = TCB_DEFAULT_INPUT_POINTS;
+    if (access(path, R_OK) != 0)
+        return tcb_fail(err, TCB_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
+    h5_quiet q;
+    quiet_begin(&q);
+    hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    int rc = file < 0 ? corrupt(path, "not an HDF5 file", err) : check_key(file, path, key, err);
+    if (!rc) rc = read_contents(file, path, out, err);
+    if (file >= 0) H5Fclose(file);
+    quiet_end(&q);
+    if (rc) tcb_sequence_free(out);
+    return rc;
+}
+
+/* ---- OBJ directory + cache ------------------------------------------- */
+
+typedef struct strbuf {
+    char *s;
+    size_t len, cap;
+} strbuf;
+
+static int sb_printf(strbuf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static int sb_printf(strbuf *b, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    if (n < 0) return -1;
+    if (b->len + (size_t)n + 1 > b->cap) {
+        size_t cap = b->cap ? b->cap : 1024;
+        while (cap < b->len + (size_t)n + 1) cap *= 2;
+        char *p = realloc(b->s, cap);
+        if (!p) return -1;
+        b->s = p;
+        b->cap = cap;
+    }
+    va_start(ap, fmt);
+    vsnprintf(b->s + b->len, b->cap - b->len, fmt, ap);
+    va_end(ap);
+    b->len += (size_t)n;
+    return 0;
+}
+
+/* Everything the cached arrays depend on: a change to any frame file (name,
+ * size, mtime), to the options, the name (it seeds the pools) or the format
+ * makes a different key. */
+static int build_key(const char *name, const tcb_load_opts *o, int pool_size, const tcb_objdir_frame *frames,
+                     int n, strbuf *key)
+{
+    if (sb_printf(key, "tcbench sequence cache v%d\nname=%s\nnorm=%d pool_size=%d pool_seed=%llu\n",
+                  CACHE_FORMAT_VERSION, name, (int)o->norm, pool_size, (unsigned long long)o->pool_seed))
+        return -1;
+    for (int i = 0; i < n; i++)
+        if (sb_printf(key, "%s %lld %lld\n", frames[i].name, frames[i].size, frames[i].mtime_ns)) return -1;
+    return 0;
+}
+
+static uint64_t fnv1a(const char *s)
+{
+    uint64_t h = 0xcbf29ce484222325ULL;
+    for (; *s; s++) h = (h ^ (unsigned char)*s) * 0x100000001b3ULL;
+    return h;
+}
+
+static int parse_normalize_sample(const char *dir, const tcb_objdir_frame *frames, int n, const char *name,
+                                  const tcb_load_opts *o, int pool_size, tcb_sequence *out, tcb_error *err)
+{
+    int rc = tcb_objdir_read(dir, frames, n, name, out, err);
+    if (!rc) rc = tcb_sequence_normalize(out, o->norm, err);
+    if (!rc) rc = tcb_sequence_sample_pools(out, pool_size, o->pool_seed, err);
+    if (rc) tcb_sequence_free(out);
+    return rc;
+}
+
+static int load_via_cache(const char *dir, const tcb_objdir_frame *frames, int n, const char *name,
+                          const tcb_load_opts *o, int pool_size, tcb_sequence *out, tcb_error *err)
+{
+    strbuf key = {0};
+    if (build_key(name, o, pool_size, frames, n, &key)) {
+        free(key.s);
+        return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", dir);
+    }
+    char path[TCB_PATH_MAX];
+    int rc = tcb_path_join(path, sizeof path, err, "%s/%s-%016llx.h5", o->cache_dir, name,
+                           (unsigned long long)fnv1a(key.s));
+    /* A stale, corrupt or unreadable entry is simply rebuilt. */
+    if (!rc && tcb_is_file(path) && tcb_sequence_cache_load(path, key.s, out, NULL) == TCB_OK) {
+        free(key.s);
+        return TCB_OK;
+    }
+    if (!rc) rc = parse_normalize_sample(dir, frames, n, name, o, pool_size, out, err);
+    if (!rc && (rc = tcb_sequence_cache_save(path, out, key.s, err))) tcb_sequence_free(out);
+    free(key.s);
+    return rc;
+}
+
+int tcb_sequence_load_objdir(const char *dir, const char *name, const tcb_load_opts *opts, tcb_sequence *out,
+                             tcb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    static const tcb_load_opts defaults = {TCB_NORM_NONE, TCB_DEFAULT_POOL_SIZE, 0, NULL};
+    const tcb_load_opts *o = opts ? opts : &defaults;
+    int pool_size = o->pool_size ? o->pool_size : TCB_DEFAULT_POOL_SIZE;
+    char default_name[TCB_NAME_MAX];
+    if (!name) {
+        int rc = tcb_objdir_default_name(dir, default_name, err);
+        if (rc) return rc;
+        name = default_name;
+    }
+    tcb_objdir_frame *frames;
+    int n, rc = tcb_objdir_list(dir, &frames, &n, err);
+    if (rc) return rc;
+    if (o->cache_dir && *o->cache_dir)
+        rc = load_via_cache(dir, frames, n, name, o, pool_size, out, err);
+    else
+        rc = parse_normalize_sample(dir, frames, n, name, o, pool_size, out, err);
+    free(frames);
+    return rc;
+}

@@ -1,0 +1,244 @@
+/* One cell of the grid: create the method, fit it (or reload its
+ * checkpoint), transfer and score every evaluation pair of the split.
+ *
+ * Two error channels: `merr` collects the method's failures (and bad output
+ * it hands back), which end up in the cell file as status failed/diverged;
+ * `herr` collects the harness's own failures, which abort the run. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness/internal.h"
+#include "tcb/fsutil.h"
+#include "tcb/metrics.h"
+
+/* Per-pair scratch, sized for the sequence once per cell. */
+typedef struct eval_bufs {
+    float *moved;   /* [nv][3] transfer output on frame j */
+    int32_t *pred;  /* [nv] predicted vertex ids of frame j */
+} eval_bufs;
+
+static int all_finite(const float *x, size_t n)
+{
+    for (size_t k = 0; k < n; k++)
+        if (!isfinite(x[k])) return 0;
+    return 1;
+}
+
+void tcb_cell_label(char *out, size_t size, const char *dataset, const char *sequence,
+                    const char *method, int seed)
+{
+    snprintf(out, size, "%s/%s/%s/seed %d", dataset, sequence, method, seed);
+}
+
+static int fill_identity(const tcb_cell_job *job, tcb_cell_result *c, tcb_error *herr)
+{
+    snprintf(c->dataset, sizeof c->dataset, "%s", job->dataset->name);
+    snprintf(c->sequence, sizeof c->sequence, "%s", job->seq->name);
+    snprintf(c->role, sizeof c->role, "%s", tcb_role_name(job->split->role));
+    snprintf(c->method, sizeof c->method, "%s", job->method->label);
+    snprintf(c->method_impl, sizeof c->method_impl, "%s", job->ops->name);
+    snprintf(c->git_revision, sizeof c->git_revision, "%s", job->git_revision);
+    snprintf(c->split_path, sizeof c->split_path, "%s", job->split_path);
+    c->seed = job->seed;
+    c->split_seed = job->split->seed;
+    c->load_s = job->load_s;
+    c->status = TCB_CELL_OK;
+    tcb_summary_init(&c->summary);
+    c->params_json = strdup(job->method->params_json);
+    if (!c->params_json) return tcb_fail(herr, TCB_ERR_NOMEM, "out of memory");
+    return TCB_OK;
+}
+
+/* Saved through a temporary name so a kill mid-save leaves no torn
+ * checkpoint for the next run to trust. A failed save costs only a refit
+ * on resume, so it is a warning, not a cell failure. */
+static void save_checkpoint(const tcb_cell_job *job, void *self, const char *path)
+{
+    char tmp[TCB_PATH_MAX];
+    tcb_error e = {0};
+    int rc = tcb_temp_path_for(path, tmp, sizeof tmp, &e);
+    if (!rc) {
+        rc = job->ops->save(self, tmp, &e);
+        if (!rc) rc = tcb_publish(tmp, path, &e);
+        else remove(tmp);
+    }
+    if (rc) tcb_report_log(&job->reporter, TCB_LOG_WARN, "checkpoint not saved: %s", e.msg);
+}
+
+/* A method that returned an error without describing it still fails the
+ * cell with a readable message. */
+static void ensure_error(tcb_error *merr, int rc)
+{
+    if (merr->code == TCB_OK)
+        merr->code = rc > TCB_OK && rc <= TCB_ERR_INTERNAL ? (tcb_status)rc : TCB_ERR_INTERNAL;
+    if (!merr->msg[0]) snprintf(merr->msg, sizeof merr->msg, "failed (%s)", tcb_status_name(merr->code));
+}
+
+/* A method's state may legitimately be NULL (stateless methods), so
+ * success is the return code, never the pointer. */
+static int create_method(const tcb_cell_job *job, void **self, tcb_error *merr)
+{
+    *self = NULL;
+    int rc = job->ops->create(job->method->params_json, self, merr);
+    if (!rc) return TCB_OK;
+    ensure_error(merr, rc);
+    tcb_error_prefix(merr, "create: ");
+    return rc;
+}
+
+/* create + (load | fit [+ save]); on failure nothing is left to destroy. */
+static int prepare_method(const tcb_cell_job *job, void **self, tcb_error *merr)
+{
+    const tcb_method_ops *ops = job->ops;
+    int rc = create_method(job, self, merr);
+    if (rc) return rc;
+    if (ops->load && job->reuse_checkpoint && tcb_is_file(job->checkpoint)) {
+        tcb_error le = {0};
+        if (ops->load(*self, job->seq, job->checkpoint, &le) == TCB_OK) return TCB_OK;
+        /* A model half-loaded from a bad checkpoint is not trusted: start over. */
+        tcb_report_log(&job->reporter, TCB_LOG_WARN, "%s: not reused (%s); fitting again",
+                       job->checkpoint, le.msg);
+        ops->destroy(*self);
+        rc = create_method(job, self, merr);
+        if (rc) return rc;
+    }
+    tcb_fit_ctx ctx = {(uint64_t)job->seed, job->threads, job->work_dir, job->reporter};
+    rc = ops->fit(*self, job->seq, &ctx, merr);
+    if (rc) {
+        ensure_error(merr, rc);
+        tcb_error_prefix(merr, "fit: ");
+        ops->destroy(*self);
+        return rc;
+    }
+    if (ops->save) save_checkpoint(job, *self, job->checkpoint);
+    return TCB_OK;
+}
+
+/* Reconstruct `frame` in the context of pair (i, j) and score it against
+ * the frame's GT vertices. */
+static void reconstruction_cd(const tcb_cell_job *job, void *self, int i, int j, int frame,
+                              tcb_rng *rng, double *cd, tcb_error *merr, tcb_error *herr)
+{
+    const tcb_sequence *seq = job->seq;
+    float *pts = NULL;
+    int n = 0;
+    int rc = job->ops->reconstruct(self, seq, i, j, frame, rng, &pts, &n, merr);
+    if (rc) {
+        ensure_error(merr, rc);
+        tcb_error_prefix(merr, "reconstruct frame %d (pair %d->%d): ", frame, i, j);
+    } else if (!pts || n <= 0)
+        tcb_fail(merr, TCB_ERR_INTERNAL, "reconstruct frame %d (pair %d->%d): returned no points",
+                 frame, i, j);
+    else if (!all_finite(pts, (size_t)n * 3))
+        tcb_fail(merr, TCB_ERR_NUMERIC,
+                 "reconstruct frame %d (pair %d->%d): returned a non-finite point", frame, i, j);
+    else
+        tcb_chamfer(pts, n, tcb_seq_frame(seq, frame), seq->n_verts, cd, herr);
+    free(pts);
+}
+
+/* Pair k of the split into rec and the summary. Failures land in merr
+ * (the method's) or herr (the harness's); the caller checks both. */
+static void eval_pair(const tcb_cell_job *job, void *self, int k, eval_bufs *b,
+                      tcb_pair_record *rec, tcb_summary *sum, tcb_error *merr, tcb_error *herr)
+{
+    const tcb_sequence *seq = job->seq;
+    int nv = seq->n_verts;
+    int i = job->split->pairs[2 * k], j = job->split->pairs[2 * k + 1];
+    char label[TCB_PATH_MAX];
+    snprintf(label, sizeof label, "eval/%s/%s/%d", job->dataset->name, seq->name, k);
+    tcb_rng rng;
+    tcb_rng_seed_stream(&rng, (uint64_t)job->seed, label);
+
+    int rc = job->ops->transfer(self, seq, i, j, tcb_seq_frame(seq, i), nv, b->moved, &rng, merr);
+    if (rc) {
+        ensure_error(merr, rc);
+        tcb_error_prefix(merr, "transfer %d->%d (pair %d): ", i, j, k);
+        return;
+    }
+    if (!all_finite(b->moved, (size_t)nv * 3)) {
+        tcb_fail(merr, TCB_ERR_NUMERIC, "transfer %d->%d (pair %d): returned a non-finite point",
+                 i, j, k);
+        return;
+    }
+    const float *verts_j = tcb_seq_frame(seq, j);
+    tcb_pair_metrics pm;
+    if (tcb_project_to_vertices(verts_j, nv, b->moved, nv, b->pred, herr) ||
+        tcb_pair_metrics_compute(verts_j, nv, b->pred, &pm, herr))
+        return;
+    double cd = NAN;
+    if (job->ops->reconstruct) {
+        double cd_i = 0, cd_j = 0;
+        reconstruction_cd(job, self, i, j, i, &rng, &cd_i, merr, herr);
+        if (!merr->code && !herr->code) reconstruction_cd(job, self, i, j, j, &rng, &cd_j, merr, herr);
+        if (merr->code || herr->code) return;
+        cd = 0.5 * (cd_i + cd_j);
+    }
+    *rec = (tcb_pair_record){i, j, pm.sl2, pm.sl2sq, pm.rank, pm.auc, cd};
+    tcb_summary_add_pair(sum, &pm, cd);
+}
+
+static void evaluate(const tcb_cell_job *job, void *self, tcb_cell_result *c, tcb_error *merr,
+                     tcb_error *herr)
+{
+    const tcb_split *split = job->split;
+    size_t nv = (size_t)job->seq->n_verts;
+    eval_bufs b = {malloc(nv * 3 * sizeof(float)), malloc(nv * sizeof(int32_t))};
+    c->pairs = calloc((size_t)split->n_pairs, sizeof *c->pairs);
+    if (!b.moved || !b.pred || !c->pairs) {
+        tcb_fail(herr, TCB_ERR_NOMEM, "out of memory for %zu vertices", nv);
+    } else {
+        char label[TCB_CELL_LABEL_MAX];
+        tcb_cell_label(label, sizeof label, job->dataset->name, job->seq->name,
+                       job->method->label, job->seed);
+        tcb_report_progress(&job->reporter, 0, split->n_pairs, label);
+        for (int k = 0; k < split->n_pairs && !merr->code && !herr->code; k++) {
+            eval_pair(job, self, k, &b, &c->pairs[k], &c->summary, merr, herr);
+            tcb_report_progress(&job->reporter, k + 1, split->n_pairs, label);
+        }
+        c->n_pairs = split->n_pairs;
+    }
+    free(b.moved);
+    free(b.pred);
+}
+
+/* A failed cell keeps its identity, timings and message, no numbers. */
+static void record_failure(tcb_cell_result *c, const tcb_error *merr)
+{
+    c->status = merr->code == TCB_ERR_NUMERIC ? TCB_CELL_DIVERGED : TCB_CELL_FAILED;
+    snprintf(c->message, sizeof c->message, "%s", merr->msg);
+    free(c->pairs);
+    c->pairs = NULL;
+    c->n_pairs = 0;
+    tcb_summary_init(&c->summary);
+}
+
+int tcb_cell_run(const tcb_cell_job *job, tcb_cell_result *out, tcb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    tcb_error merr = {0}, herr = {0};
+    for (int k = 0; k < 2 * job->split->n_pairs; k++)
+        if (job->split->pairs[k] < 0 || job->split->pairs[k] >= job->seq->n_frames)
+            return tcb_fail(err, TCB_ERR_INPUT, "%s: pair %d names frame %d of %d", job->split_path,
+                            k / 2, job->split->pairs[k], job->seq->n_frames);
+    if (fill_identity(job, out, &herr)) goto fail;
+
+    double t0 = tcb_now_seconds();
+    void *self;
+    int prepared = prepare_method(job, &self, &merr) == TCB_OK;
+    double t1 = tcb_now_seconds();
+    out->fit_s = t1 - t0;
+    if (prepared) {
+        evaluate(job, self, out, &merr, &herr);
+        job->ops->destroy(self);
+    }
+    out->eval_s = tcb_now_seconds() - t1;
+    out->peak_rss_kb = tcb_peak_rss_kb();
+    if (herr.code) goto fail;
+    if (merr.code) record_failure(out, &merr);
+    return TCB_OK;
+fail:
+    tcb_cell_free(out);
+    return tcb_fail(err, herr.code, "%s", herr.msg);
+}

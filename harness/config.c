@@ -1,0 +1,402 @@
+/* The run configuration: a strict JSON reader (every key known, every value
+ * checked, errors naming the key path) and the normalized JSON text with all
+ * defaults filled in, which the runner stores beside the results. */
+#include "tcb/config.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness/internal.h"
+#include "tcb/json.h"
+#include "tcb/synth.h"
+
+#define WHERE_MAX 512
+
+static const char *const top_keys[] = {"name", "output", "splits_dir", "cache_dir", "plugins",
+                                       "seeds", "threads", "evaluation", "datasets", "methods",
+                                       NULL};
+static const char *const eval_keys[] = {"pairs", "split_seed", "pool_size", "pool_seed",
+                                        "input_points", NULL};
+static const char *const synthetic_keys[] = {"name", "source", "seed", "frames", "normalization",
+                                             "sampling", "sequences", NULL};
+static const char *const objdir_keys[] = {"name", "source", "root", "optional", "normalization",
+                                          "sampling", "sequences", NULL};
+static const char *const sequence_keys[] = {"name", "role", NULL};
+static const char *const method_keys[] = {"name", "method", "params", NULL};
+
+const char *const tcb_config_source_names[] = {"synthetic", "objdir", NULL};
+const char *const tcb_config_norm_names[] = {"none", "first_frame", "per_frame", NULL};
+const char *const tcb_config_sampling_names[] = {"without_replacement", "with_replacement", NULL};
+
+/* The json helpers join `where` and a key with '.', which at the top level
+ * would read "quick.json:.threads"; turn that into "quick.json: threads". */
+static int fix_top(int rc, const char *origin, tcb_error *err)
+{
+    size_t n = strlen(origin);
+    if (rc && err && strncmp(err->msg, origin, n) == 0 && err->msg[n] == ':' &&
+        err->msg[n + 1] == '.')
+        err->msg[n + 1] = ' ';
+    return rc;
+}
+
+/* Names become path components of the run directory: keep them portable. */
+static int check_name(const char *name, size_t cap, const char *where, const char *key,
+                      tcb_error *err)
+{
+    size_t len = strlen(name);
+    if (len == 0 || len >= cap)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: must be 1 to %zu characters", where, key,
+                        cap - 1);
+    if (name[0] == '.')
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: '%s' must not start with '.'", where, key,
+                        name);
+    for (const char *p = name; *p; p++) {
+        int ok = (*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') ||
+                 (*p >= '0' && *p <= '9') || *p == '_' || *p == '-' || *p == '.';
+        if (!ok)
+            return tcb_fail(err, TCB_ERR_INPUT,
+                            "%s.%s: '%s' may only contain letters, digits, '_', '-' and '.'",
+                            where, key, name);
+    }
+    return TCB_OK;
+}
+
+static int copy_str(char *dst, size_t cap, const char *src, const char *where, const char *key,
+                    tcb_error *err)
+{
+    if (strlen(src) >= cap)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: longer than %zu characters", where, key,
+                        cap - 1);
+    memcpy(dst, src, strlen(src) + 1);
+    return TCB_OK;
+}
+
+/* obj[key] as an array; *out = NULL when absent and not required. */
+static int get_array(const cJSON *obj, const char *key, const char *where, int required,
+                     const cJSON **out, tcb_error *err)
+{
+    *out = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!*out && required)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: required key is missing", where, key);
+    if (*out && !cJSON_IsArray(*out))
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: expected an array", where, key);
+    return TCB_OK;
+}
+
+static int parse_sequence(const cJSON *o, const char *where, const tcb_dataset_spec *d,
+                          tcb_sequence_spec *s, tcb_error *err)
+{
+    const char *name, *role;
+    int rc = tcb_json_expect_keys(o, where, sequence_keys, err);
+    if (!rc) rc = tcb_json_str(o, "name", where, 1, NULL, &name, err);
+    if (!rc) rc = check_name(name, sizeof s->name, where, "name", err);
+    if (!rc) rc = tcb_json_str(o, "role", where, 1, NULL, &role, err);
+    if (rc) return rc;
+    if (tcb_role_parse(role, &s->role) != 0)
+        return tcb_fail(err, TCB_ERR_INPUT,
+                        "%s.role: unknown role '%s' (expected train, validation or test)", where,
+                        role);
+    snprintf(s->name, sizeof s->name, "%s", name);
+    if (d->source != TCB_SOURCE_SYNTHETIC) return TCB_OK;
+    for (int k = 0; k < tcb_synth_count(); k++)
+        if (strcmp(tcb_synth_name(k), name) == 0) return TCB_OK;
+    char list[512] = "";
+    for (int k = 0; k < tcb_synth_count(); k++) {
+        size_t used = strlen(list);
+        snprintf(list + used, sizeof list - used, "%s%s", k ? ", " : "", tcb_synth_name(k));
+    }
+    return tcb_fail(err, TCB_ERR_INPUT, "%s.name: unknown synthetic sequence '%s' (expected %s)",
+                    where, name, list);
+}
+
+static int parse_sequences(const cJSON *o, const char *where, tcb_dataset_spec *d,
+                           tcb_error *err)
+{
+    const cJSON *arr;
+    int rc = get_array(o, "sequences", where, 1, &arr, err);
+    if (rc) return rc;
+    int n = cJSON_GetArraySize(arr);
+    if (n == 0)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.sequences: must list at least one sequence",
+                        where);
+    d->sequences = calloc((size_t)n, sizeof *d->sequences);
+    if (!d->sequences) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", where);
+    char sw[WHERE_MAX + 32]; /* where + ".sequences[k]" */
+    for (int k = 0; k < n; k++) {
+        snprintf(sw, sizeof sw, "%s.sequences[%d]", where, k);
+        rc = parse_sequence(cJSON_GetArrayItem(arr, k), sw, d, &d->sequences[k], err);
+        if (rc) return rc;
+        d->n_sequences = k + 1;
+        for (int m = 0; m < k; m++)
+            if (strcmp(d->sequences[m].name, d->sequences[k].name) == 0)
+                return tcb_fail(err, TCB_ERR_INPUT,
+                                "%s.name: duplicate sequence '%s' (also %s.sequences[%d])", sw,
+                                d->sequences[k].name, where, m);
+    }
+    return TCB_OK;
+}
+
+static int parse_dataset(const cJSON *o, const char *where, tcb_dataset_spec *d, tcb_error *err)
+{
+    const char *name, *root;
+    int source, norm, sampling;
+    long long seed, frames;
+    int rc = tcb_json_expect_object(o, where, err);
+    if (!rc) rc = tcb_json_enum(o, "source", where, 1, 0, tcb_config_source_names, &source, err);
+    if (rc) return rc;
+    d->source = (tcb_source)source;
+    int synthetic = d->source == TCB_SOURCE_SYNTHETIC;
+    rc = tcb_json_expect_keys(o, where, synthetic ? synthetic_keys : objdir_keys, err);
+    if (!rc) rc = tcb_json_str(o, "name", where, 1, NULL, &name, err);
+    if (!rc) rc = check_name(name, sizeof d->name, where, "name", err);
+    if (!rc) rc = tcb_json_int(o, "seed", where, 0, 0, 0, LLONG_MAX, &seed, err);
+    if (!rc) rc = tcb_json_int(o, "frames", where, 0, 0, 0, 100000, &frames, err);
+    if (!rc) rc = tcb_json_str(o, "root", where, !synthetic, "", &root, err);
+    if (!rc) rc = copy_str(d->root, sizeof d->root, root, where, "root", err);
+    if (!rc) rc = tcb_json_bool(o, "optional", where, 0, 0, &d->optional, err);
+    if (!rc)
+        rc = tcb_json_enum(o, "normalization", where, 0, TCB_NORM_FIRST_FRAME, tcb_config_norm_names, &norm,
+                           err);
+    if (!rc) rc = tcb_json_enum(o, "sampling", where, 0, 0, tcb_config_sampling_names, &sampling, err);
+    if (rc) return rc;
+    if (!synthetic && !root[0])
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.root: must not be empty", where);
+    snprintf(d->name, sizeof d->name, "%s", name);
+    d->seed = (uint64_t)seed;
+    d->frames = (int)frames;
+    d->norm = (tcb_normalization)norm;
+    d->with_replacement = sampling == 1;
+    return parse_sequences(o, where, d, err);
+}
+
+static int parse_method(const cJSON *o, const char *where, tcb_method_spec *m, tcb_error *err)
+{
+    const char *label, *impl;
+    int rc = tcb_json_expect_keys(o, where, method_keys, err);
+    if (!rc) rc = tcb_json_str(o, "name", where, 1, NULL, &label, err);
+    if (!rc) rc = check_name(label, sizeof m->label, where, "name", err);
+    if (!rc) rc = tcb_json_str(o, "method", where, 0, label, &impl, err);
+    if (!rc) rc = copy_str(m->method, sizeof m->method, impl, where, "method", err);
+    if (rc) return rc;
+    snprintf(m->label, sizeof m->label, "%s", label);
+    if (!m->method[0]) return tcb_fail(err, TCB_ERR_INPUT, "%s.method: must not be empty", where);
+    const cJSON *params = cJSON_GetObjectItemCaseSensitive(o, "params");
+    if (params && !cJSON_IsObject(params))
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.params: expected an object", where);
+    /* The method itself validates the keys when it is created. */
+    m->params_json = params ? cJSON_PrintUnformatted(params) : strdup("{}");
+    if (!m->params_json) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", where);
+    return TCB_OK;
+}
+
+static int parse_datasets(const cJSON *root, const char *origin, tcb_config *c, tcb_error *err)
+{
+    char top[WHERE_MAX], w[WHERE_MAX];
+    snprintf(top, sizeof top, "%s:", origin);
+    const cJSON *arr;
+    int rc = fix_top(get_array(root, "datasets", top, 1, &arr, err), origin, err);
+    if (rc) return rc;
+    int n = cJSON_GetArraySize(arr);
+    if (n == 0)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: datasets: must list at least one dataset",
+                        origin);
+    c->datasets = calloc((size_t)n, sizeof *c->datasets);
+    if (!c->datasets) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", origin);
+    for (int k = 0; k < n; k++) {
+        snprintf(w, sizeof w, "%s: datasets[%d]", origin, k);
+        rc = parse_dataset(cJSON_GetArrayItem(arr, k), w, &c->datasets[k], err);
+        c->n_datasets = k + 1; /* so tcb_config_free releases its sequences */
+        if (rc) return rc;
+        for (int m = 0; m < k; m++)
+            if (strcmp(c->datasets[m].name, c->datasets[k].name) == 0)
+                return tcb_fail(err, TCB_ERR_INPUT,
+                                "%s.name: duplicate dataset '%s' (also datasets[%d])", w,
+                                c->datasets[k].name, m);
+    }
+    return TCB_OK;
+}
+
+static int parse_methods(const cJSON *root, const char *origin, tcb_config *c, tcb_error *err)
+{
+    char top[WHERE_MAX], w[WHERE_MAX];
+    snprintf(top, sizeof top, "%s:", origin);
+    const cJSON *arr;
+    int rc = fix_top(get_array(root, "methods", top, 1, &arr, err), origin, err);
+    if (rc) return rc;
+    int n = cJSON_GetArraySize(arr);
+    if (n == 0)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: methods: must list at least one method", origin);
+    c->methods = calloc((size_t)n, sizeof *c->methods);
+    if (!c->methods) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", origin);
+    for (int k = 0; k < n; k++) {
+        snprintf(w, sizeof w, "%s: methods[%d]", origin, k);
+        rc = parse_method(cJSON_GetArrayItem(arr, k), w, &c->methods[k], err);
+        c->n_methods = k + 1;
+        if (rc) return rc;
+        for (int m = 0; m < k; m++)
+            if (strcmp(c->methods[m].label, c->methods[k].label) == 0)
+                return tcb_fail(err, TCB_ERR_INPUT,
+                                "%s.name: duplicate method label '%s' (also methods[%d])", w,
+                                c->methods[k].label, m);
+    }
+    return TCB_OK;
+}
+
+static int parse_seeds(const cJSON *root, const char *origin, tcb_config *c, tcb_error *err)
+{
+    char top[WHERE_MAX];
+    snprintf(top, sizeof top, "%s:", origin);
+    const cJSON *arr;
+    int rc = fix_top(get_array(root, "seeds", top, 0, &arr, err), origin, err);
+    if (rc) return rc;
+    int n = arr ? cJSON_GetArraySize(arr) : 1;
+    if (n == 0) return tcb_fail(err, TCB_ERR_INPUT, "%s: seeds: must list at least one seed", origin);
+    c->seeds = calloc((size_t)n, sizeof *c->seeds);
+    if (!c->seeds) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", origin);
+    c->n_seeds = n;
+    for (int k = 0; arr && k < n; k++) {
+        const cJSON *s = cJSON_GetArrayItem(arr, k);
+        double v = cJSON_IsNumber(s) ? s->valuedouble : -1;
+        if (v < 0 || v > INT_MAX || v != floor(v))
+            return tcb_fail(err, TCB_ERR_INPUT,
+                            "%s: seeds[%d]: expected a non-negative integer below 2^31", origin, k);
+        c->seeds[k] = (int)v;
+        for (int m = 0; m < k; m++)
+            if (c->seeds[m] == c->seeds[k])
+                return tcb_fail(err, TCB_ERR_INPUT, "%s: seeds[%d]: duplicate seed %d", origin, k,
+                                c->seeds[k]);
+    }
+    return TCB_OK;
+}
+
+static int parse_plugins(const cJSON *root, const char *origin, tcb_config *c, tcb_error *err)
+{
+    char top[WHERE_MAX];
+    snprintf(top, sizeof top, "%s:", origin);
+    const cJSON *arr;
+    int rc = fix_top(get_array(root, "plugins", top, 0, &arr, err), origin, err);
+    if (rc || !arr) return rc;
+    int n = cJSON_GetArraySize(arr);
+    c->plugins = calloc((size_t)n + 1, sizeof *c->plugins);
+    if (!c->plugins) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", origin);
+    for (int k = 0; k < n; k++) {
+        const cJSON *p = cJSON_GetArrayItem(arr, k);
+        if (!cJSON_IsString(p) || !p->valuestring[0])
+            return tcb_fail(err, TCB_ERR_INPUT, "%s: plugins[%d]: expected a non-empty path",
+                            origin, k);
+        c->plugins[k] = strdup(p->valuestring);
+        if (!c->plugins[k]) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", origin);
+        c->n_plugins = k + 1;
+    }
+    return TCB_OK;
+}
+
+static int parse_evaluation(const cJSON *root, const char *origin, tcb_config *c, tcb_error *err)
+{
+    char w[WHERE_MAX];
+    snprintf(w, sizeof w, "%s: evaluation", origin);
+    const cJSON *ev = cJSON_GetObjectItemCaseSensitive(root, "evaluation");
+    cJSON *empty = NULL;
+    if (!ev) ev = empty = cJSON_CreateObject();
+    long long pairs, split_seed, pool, pool_seed, input;
+    int rc = tcb_json_expect_keys(ev, w, eval_keys, err);
+    if (!rc)
+        rc = tcb_json_int(ev, "pairs", w, 0, TCB_DEFAULT_EVAL_PAIRS, 1, 1000000, &pairs, err);
+    if (!rc) rc = tcb_json_int(ev, "split_seed", w, 0, 2021, 0, LLONG_MAX, &split_seed, err);
+    if (!rc)
+        rc = tcb_json_int(ev, "pool_size", w, 0, TCB_DEFAULT_POOL_SIZE, 1, 10000000, &pool, err);
+    if (!rc) rc = tcb_json_int(ev, "pool_seed", w, 0, 0, 0, LLONG_MAX, &pool_seed, err);
+    if (!rc)
+        rc = tcb_json_int(ev, "input_points", w, 0, TCB_DEFAULT_INPUT_POINTS, 1, 10000000,
+                          &input, err);
+    cJSON_Delete(empty);
+    if (rc) return rc;
+    c->eval_pairs = (int)pairs;
+    c->split_seed = (uint64_t)split_seed;
+    c->pool_size = (int)pool;
+    c->pool_seed = (uint64_t)pool_seed;
+    c->input_points = (int)input;
+    return TCB_OK;
+}
+
+/* name, output, splits_dir, cache_dir, threads. */
+static int parse_scalars(const cJSON *root, const char *origin, tcb_config *c, tcb_error *err)
+{
+    char top[WHERE_MAX];
+    snprintf(top, sizeof top, "%s:", origin);
+    const char *name, *output, *splits, *cache;
+    long long threads;
+    int rc = tcb_json_str(root, "name", top, 1, NULL, &name, err);
+    if (!rc) rc = check_name(name, sizeof c->name, top, "name", err);
+    if (!rc) rc = tcb_json_str(root, "output", top, 0, NULL, &output, err);
+    if (!rc) rc = tcb_json_str(root, "splits_dir", top, 0, "splits", &splits, err);
+    if (!rc) rc = tcb_json_str(root, "cache_dir", top, 0, ".tcbench-cache", &cache, err);
+    if (!rc) rc = tcb_json_int(root, "threads", top, 0, 2, 1, 1024, &threads, err);
+    if (!rc && output) rc = copy_str(c->output, sizeof c->output, output, top, "output", err);
+    if (!rc) rc = copy_str(c->splits_dir, sizeof c->splits_dir, splits, top, "splits_dir", err);
+    if (!rc) rc = copy_str(c->cache_dir, sizeof c->cache_dir, cache, top, "cache_dir", err);
+    if (rc) return fix_top(rc, origin, err);
+    snprintf(c->name, sizeof c->name, "%s", name);
+    if (!output) snprintf(c->output, sizeof c->output, "runs/%s", name);
+    if (!c->output[0] || !c->splits_dir[0])
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: %s: must not be empty", origin,
+                        c->output[0] ? "splits_dir" : "output");
+    c->threads = (int)threads;
+    return TCB_OK;
+}
+
+int tcb_config_parse(const char *text, const char *origin, tcb_config *out, tcb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (strlen(origin) >= sizeof out->path)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: path too long", origin);
+    snprintf(out->path, sizeof out->path, "%s", origin);
+    cJSON *root;
+    int rc = tcb_json_parse(text, origin, &root, err);
+    if (rc) return rc;
+    char top[WHERE_MAX];
+    snprintf(top, sizeof top, "%s:", origin);
+    rc = tcb_json_expect_object(root, origin, err);
+    if (!rc) rc = fix_top(tcb_json_expect_keys(root, top, top_keys, err), origin, err);
+    if (!rc) rc = parse_scalars(root, origin, out, err);
+    if (!rc) rc = parse_plugins(root, origin, out, err);
+    if (!rc) rc = parse_seeds(root, origin, out, err);
+    if (!rc) rc = parse_evaluation(root, origin, out, err);
+    if (!rc) rc = parse_datasets(root, origin, out, err);
+    if (!rc) rc = parse_methods(root, origin, out, err);
+    cJSON_Delete(root);
+    if (!rc) {
+        out->json_text = tcb_config_normalized_json(out);
+        if (!out->json_text) rc = tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", origin);
+    }
+    if (rc) tcb_config_free(out);
+    return rc;
+}
+
+int tcb_config_load(const char *path, tcb_config *out, tcb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    char *text;
+    int rc = tcb_read_file(path, &text, NULL, err);
+    if (rc) return rc;
+    rc = tcb_config_parse(text, path, out, err);
+    free(text);
+    return rc;
+}
+
+void tcb_config_free(tcb_config *c)
+{
+    if (!c) return;
+    for (int k = 0; k < c->n_plugins; k++) free(c->plugins[k]);
+    free(c->plugins);
+    free(c->seeds);
+    for (int k = 0; k < c->n_datasets; k++) free(c->datasets[k].sequences);
+    free(c->datasets);
+    for (int k = 0; k < c->n_methods; k++) free(c->methods[k].params_json);
+    free(c->methods);
+    free(c->json_text);
+    memset(c, 0, sizeof *c);
+}

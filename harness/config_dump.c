@@ -1,0 +1,75 @@
+/* The normalized config: what was actually run, every default spelled out,
+ * saved as <run>/config.json so a results directory documents itself. */
+#include <cjson/cJSON.h>
+
+#include "harness/internal.h"
+
+static cJSON *dump_evaluation(const tcb_config *c)
+{
+    cJSON *ev = cJSON_CreateObject();
+    cJSON_AddNumberToObject(ev, "pairs", c->eval_pairs);
+    cJSON_AddNumberToObject(ev, "split_seed", (double)c->split_seed);
+    cJSON_AddNumberToObject(ev, "pool_size", c->pool_size);
+    cJSON_AddNumberToObject(ev, "pool_seed", (double)c->pool_seed);
+    cJSON_AddNumberToObject(ev, "input_points", c->input_points);
+    return ev;
+}
+
+static cJSON *dump_dataset(const tcb_dataset_spec *d)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "name", d->name);
+    cJSON_AddStringToObject(o, "source", tcb_config_source_names[d->source]);
+    if (d->source == TCB_SOURCE_SYNTHETIC) {
+        cJSON_AddNumberToObject(o, "seed", (double)d->seed);
+        cJSON_AddNumberToObject(o, "frames", d->frames);
+    } else {
+        cJSON_AddStringToObject(o, "root", d->root);
+        cJSON_AddBoolToObject(o, "optional", d->optional);
+    }
+    cJSON_AddStringToObject(o, "normalization", tcb_config_norm_names[d->norm]);
+    cJSON_AddStringToObject(o, "sampling", tcb_config_sampling_names[d->with_replacement != 0]);
+    cJSON *seqs = cJSON_AddArrayToObject(o, "sequences");
+    for (int k = 0; k < d->n_sequences; k++) {
+        cJSON *s = cJSON_CreateObject();
+        cJSON_AddStringToObject(s, "name", d->sequences[k].name);
+        cJSON_AddStringToObject(s, "role", tcb_role_name(d->sequences[k].role));
+        cJSON_AddItemToArray(seqs, s);
+    }
+    return o;
+}
+
+static cJSON *dump_method(const tcb_method_spec *m)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "name", m->label);
+    cJSON_AddStringToObject(o, "method", m->method);
+    cJSON *params = cJSON_Parse(m->params_json); /* printed by cJSON: always valid */
+    cJSON_AddItemToObject(o, "params", params ? params : cJSON_CreateObject());
+    return o;
+}
+
+char *tcb_config_normalized_json(const tcb_config *c)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o) return NULL;
+    cJSON_AddStringToObject(o, "name", c->name);
+    cJSON_AddStringToObject(o, "output", c->output);
+    cJSON_AddStringToObject(o, "splits_dir", c->splits_dir);
+    cJSON_AddStringToObject(o, "cache_dir", c->cache_dir);
+    cJSON *plugins = cJSON_AddArrayToObject(o, "plugins");
+    for (int k = 0; k < c->n_plugins; k++)
+        cJSON_AddItemToArray(plugins, cJSON_CreateString(c->plugins[k]));
+    cJSON *seeds = cJSON_AddArrayToObject(o, "seeds");
+    for (int k = 0; k < c->n_seeds; k++) cJSON_AddItemToArray(seeds, cJSON_CreateNumber(c->seeds[k]));
+    cJSON_AddNumberToObject(o, "threads", c->threads);
+    cJSON_AddItemToObject(o, "evaluation", dump_evaluation(c));
+    cJSON *datasets = cJSON_AddArrayToObject(o, "datasets");
+    for (int k = 0; k < c->n_datasets; k++)
+        cJSON_AddItemToArray(datasets, dump_dataset(&c->datasets[k]));
+    cJSON *methods = cJSON_AddArrayToObject(o, "methods");
+    for (int k = 0; k < c->n_methods; k++) cJSON_AddItemToArray(methods, dump_method(&c->methods[k]));
+    char *text = cJSON_Print(o);
+    cJSON_Delete(o);
+    return text;
+}

@@ -1,0 +1,426 @@
+/* tcbench — the command-line interface.
+ *
+ * A thin layer over libtcbench: parse arguments, call the library, print.
+ * Data (tables, lists) goes to stdout, status lines and errors to stderr.
+ * Every error is one line "tcbench: <message>"; bad usage, bad input and
+ * unreadable paths exit 2, other failures 1. */
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness/internal.h"
+#include "tcb/tcb.h"
+
+/* ---- options -------------------------------------------------------- */
+
+enum {
+    F_OUT, F_ONLY, F_FORCE, F_QUIET, F_REPORT, F_SEED, F_FRAMES, F_SEQUENCE, F_UPDATE,
+    F_PLUGIN, F_HELP, F_COUNT
+};
+#define BIT(f) (1u << (f))
+
+static const struct {
+    const char *name;
+    int takes_value;
+} flags[F_COUNT] = {
+    [F_OUT] = {"--out", 1},      [F_ONLY] = {"--only", 1},       [F_FORCE] = {"--force", 0},
+    [F_QUIET] = {"--quiet", 0},  [F_REPORT] = {"--report", 0},   [F_SEED] = {"--seed", 1},
+    [F_FRAMES] = {"--frames", 1}, [F_SEQUENCE] = {"--sequence", 1}, [F_UPDATE] = {"--update", 0},
+    [F_PLUGIN] = {"--plugin", 1}, [F_HELP] = {"--help", 0},
+};
+
+#define MAX_PLUGINS 64
+#define MAX_ARGS 4
+
+typedef struct cli {
+    const char *arg[MAX_ARGS];   /* positional arguments */
+    int n_args;
+    const char *value[F_COUNT];  /* last value of each flag taking one */
+    int set[F_COUNT];            /* flag given */
+    const char *plugins[MAX_PLUGINS];
+    int n_plugins;
+} cli;
+
+typedef struct command {
+    const char *name;
+    int (*fn)(const cli *c);
+    unsigned accepts;       /* BIT(F_...) of the command's own flags */
+    int min_args, max_args;
+    const char *arg_names;  /* for "missing ..." messages */
+    const char *help;
+} command;
+
+static int fail(const tcb_error *err)
+{
+    fprintf(stderr, "tcbench: %s\n", err->msg);
+    return tcb_status_exit_code(err->code);
+}
+
+/* Bad usage: names the command and the offending word, exits 2. */
+static int usage_error(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static int usage_error(const char *cmd, const char *fmt, ...)
+{
+    fprintf(stderr, "tcbench: %s%s", cmd ? cmd : "", cmd ? ": " : "");
+    va_list ap;
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, " (see 'tcbench %s%s--help')\n", cmd ? cmd : "", cmd ? " " : "");
+    return 2;
+}
+
+/* A non-negative integer option, strictly parsed. */
+static int int_option(const cli *c, int f, long long def, long long *out)
+{
+    *out = def;
+    const char *s = c->value[f];
+    if (!s) return 0;
+    char *end;
+    errno = 0;
+    long long v = strtoll(s, &end, 10);
+    if (!*s || *end || errno || v < 0) {
+        fprintf(stderr, "tcbench: %s: expected a non-negative integer, got '%s'\n", flags[f].name, s);
+        return 2;
+    }
+    *out = v;
+    return 0;
+}
+
+/* ---- commands ------------------------------------------------------- */
+
+static int cmd_run(const cli *c)
+{
+    tcb_error err = {0};
+    tcb_config cfg;
+    if (tcb_config_load(c->arg[0], &cfg, &err)) return fail(&err);
+    tcb_term_progress tp;
+    tcb_term_progress_init(&tp, stderr, c->set[F_QUIET] ? 1 : -1);
+    tcb_run_opts opts = {c->value[F_OUT], c->value[F_ONLY], c->set[F_FORCE],
+                         tcb_term_progress_reporter(&tp)};
+    tcb_run_stats st;
+    int rc = tcb_run(&cfg, &opts, &st, &err);
+    tcb_term_progress_finish(&tp);
+    char run_dir[TCB_PATH_MAX];
+    snprintf(run_dir, sizeof run_dir, "%s", opts.output ? opts.output : cfg.output);
+    tcb_config_free(&cfg);
+    if (rc) return fail(&err);
+    fprintf(stderr, "cells: %d in all, %d computed, %d already done, %d failed\n", st.cells_total,
+            st.cells_done, st.cells_skipped, st.cells_failed);
+    fprintf(stderr, "results: %s\n", run_dir);
+    if (!c->set[F_REPORT]) {
+        fprintf(stderr, "make the report: tcbench report %s\n", run_dir);
+        return 0;
+    }
+    if (tcb_report_write(run_dir, NULL, c->set[F_QUIET] ? NULL : stdout, &err)) return fail(&err);
+    fprintf(stderr, "report: %s/report/\n", run_dir);
+    return 0;
+}
+
+static int cmd_report(const cli *c)
+{
+    tcb_error err = {0};
+    const char *out = c->value[F_OUT];
+    if (tcb_report_write(c->arg[0], out, c->set[F_QUIET] ? NULL : stdout, &err)) return fail(&err);
+    if (out) fprintf(stderr, "report: %s/\n", out);
+    else fprintf(stderr, "report: %s/report/\n", c->arg[0]);
+    return 0;
+}
+
+static int cmd_methods(const cli *c)
+{
+    (void)c;
+    int wn = 4, wo = 6;
+    for (int k = 0; k < tcb_registry_count(); k++) {
+        int n = (int)strlen(tcb_registry_get(k)->name), o = (int)strlen(tcb_registry_origin(k));
+        wn = n > wn ? n : wn;
+        wo = o > wo ? o : wo;
+    }
+    printf("%-*s  %-*s  %s\n", wn, "NAME", wo, "ORIGIN", "DESCRIPTION");
+    for (int k = 0; k < tcb_registry_count(); k++) {
+        const tcb_method_ops *m = tcb_registry_get(k);
+        printf("%-*s  %-*s  %s\n", wn, m->name, wo, tcb_registry_origin(k),
+               m->description ? m->description : "");
+    }
+    return 0;
+}
+
+static int synth_index(const char *name)
+{
+    for (int k = 0; k < tcb_synth_count(); k++)
+        if (strcmp(tcb_synth_name(k), name) == 0) return k;
+    return -1;
+}
+
+static int datasets_synth(const cli *c)
+{
+    long long seed, frames;
+    if (!c->value[F_OUT]) return usage_error("datasets synth", "%s is required", "--out DIR");
+    if (int_option(c, F_SEED, 0, &seed) || int_option(c, F_FRAMES, 0, &frames)) return 2;
+    const char *only = c->value[F_SEQUENCE];
+    if (only && synth_index(only) < 0)
+        return usage_error("datasets synth", "no synthetic sequence named '%s'", only);
+    for (int k = 0; k < tcb_synth_count(); k++) {
+        const char *name = tcb_synth_name(k);
+        if (only && strcmp(only, name) != 0) continue;
+        tcb_error err = {0};
+        tcb_sequence seq = {0};
+        char dir[TCB_PATH_MAX];
+        int rc = tcb_path_join(dir, sizeof dir, &err, "%s/%s", c->value[F_OUT], name);
+        if (!rc) rc = tcb_synth_generate(name, (uint64_t)seed, (int)frames, &seq, &err);
+        if (!rc) rc = tcb_sequence_write_objdir(&seq, dir, &err);
+        if (!rc) fprintf(stderr, "wrote %s/ (%d frames, %d vertices)\n", dir, seq.n_frames, seq.n_verts);
+        tcb_sequence_free(&seq);
+        if (rc) return fail(&err);
+    }
+    return 0;
+}
+
+static int cmd_datasets(const cli *c)
+{
+    if (strcmp(c->arg[0], "synth") == 0) return datasets_synth(c);
+    if (strcmp(c->arg[0], "list") != 0)
+        return usage_error("datasets", "unknown action '%s' (expected list or synth)", c->arg[0]);
+    for (int f = 0; f < F_COUNT; f++)
+        if (f != F_PLUGIN && c->set[f])
+            return usage_error("datasets list", "%s applies to 'datasets synth' only", flags[f].name);
+    for (int k = 0; k < tcb_synth_count(); k++)
+        printf("%-20s %s\n", tcb_synth_name(k), tcb_synth_description(k));
+    return 0;
+}
+
+static int cmd_check(const cli *c)
+{
+    tcb_error err = {0};
+    const char *run = c->arg[0], *baseline = c->arg[1];
+    if (c->set[F_UPDATE]) {
+        if (tcb_baseline_write(run, baseline, &err)) return fail(&err);
+        fprintf(stderr, "baseline written: %s\n", baseline);
+        return 0;
+    }
+    int n_drift = 0;
+    if (tcb_check(run, baseline, stdout, &n_drift, &err)) return fail(&err);
+    if (!n_drift) return 0;
+    fprintf(stderr, "tcbench: %d row%s of %s drifted from %s\n", n_drift, n_drift == 1 ? "" : "s",
+            run, baseline);
+    return 1;
+}
+
+static int cmd_version(const cli *c)
+{
+    (void)c;
+    char rev[64];
+    tcb_git_revision(rev, sizeof rev);
+    printf("tcbench %s (git %s)\n", TCB_VERSION, rev);
+    return 0;
+}
+
+static int cmd_help(const cli *c);
+
+static const command commands[] = {
+    {"run", cmd_run, BIT(F_OUT) | BIT(F_ONLY) | BIT(F_FORCE) | BIT(F_QUIET) | BIT(F_REPORT), 1, 1,
+     "CONFIG",
+     "usage: tcbench run CONFIG [--out DIR] [--only METHOD] [--force] [--quiet] [--report]\n"
+     "                  [--plugin SO]...\n"
+     "\n"
+     "Runs every (dataset, sequence, method, seed) cell of the config and writes one\n"
+     "result file per cell. Finished cells are skipped, so rerunning a killed run\n"
+     "resumes it.\n"
+     "\n"
+     "options:\n"
+     "  --out DIR      run directory (default: the config's \"output\")\n"
+     "  --only METHOD  run only the method with this label\n"
+     "  --force        recompute cells that are already finished\n"
+     "  --quiet        no progress output (also when the CI variable is set)\n"
+     "  --report       write the report when the run is done\n"
+     "  --plugin SO    load out-of-tree methods from a shared object (repeatable)\n"
+     "\n"
+     "example:\n"
+     "  tcbench run configs/quick.json --out runs/quick --report\n"},
+    {"report", cmd_report, BIT(F_OUT) | BIT(F_QUIET), 1, 1, "RUN_DIR",
+     "usage: tcbench report RUN_DIR [--out DIR] [--quiet]\n"
+     "\n"
+     "Writes tables.md, tables.tex, results.csv and PCK plots for a run directory and\n"
+     "prints the Markdown tables.\n"
+     "\n"
+     "options:\n"
+     "  --out DIR  where to write (default: RUN_DIR/report)\n"
+     "  --quiet    do not print the tables\n"
+     "\n"
+     "example:\n"
+     "  tcbench report runs/quick\n"},
+    {"methods", cmd_methods, 0, 0, 0, "",
+     "usage: tcbench methods [--plugin SO]...\n"
+     "\n"
+     "Lists the registered methods: name, origin (built-in or plug-in path) and\n"
+     "description.\n"
+     "\n"
+     "options:\n"
+     "  --plugin SO  also load the methods of this plug-in (repeatable)\n"
+     "\n"
+     "example:\n"
+     "  tcbench methods --plugin build/examples/libmy_method.so\n"},
+    {"datasets", cmd_datasets, BIT(F_OUT) | BIT(F_SEED) | BIT(F_FRAMES) | BIT(F_SEQUENCE), 1, 1,
+     "ACTION (list or synth)",
+     "usage: tcbench datasets list\n"
+     "       tcbench datasets synth --out DIR [--seed N] [--frames N] [--sequence NAME]\n"
+     "\n"
+     "list:  the embedded synthetic sequences.\n"
+     "synth: writes synthetic sequences as OBJ files, DIR/<name>/mesh_NNNN.obj\n"
+     "       (raw coordinates, before normalization).\n"
+     "\n"
+     "options:\n"
+     "  --out DIR        output directory (synth; required)\n"
+     "  --seed N         generator seed (default 0)\n"
+     "  --frames N       frames per sequence (default: the sequence's own length)\n"
+     "  --sequence NAME  only this sequence (default: all)\n"
+     "\n"
+     "example:\n"
+     "  tcbench datasets synth --out data/synth --sequence quadruped_walk\n"},
+    {"check", cmd_check, BIT(F_UPDATE), 2, 2, "RUN_DIR BASELINE",
+     "usage: tcbench check RUN_DIR BASELINE [--update]\n"
+     "\n"
+     "Compares a run with a baseline file and prints the differences. Exit status:\n"
+     "0 when every row is within tolerance, 1 on drift (including missing or extra\n"
+     "rows), 2 on unreadable or malformed input.\n"
+     "\n"
+     "options:\n"
+     "  --update  write BASELINE from the run instead of comparing\n"
+     "\n"
+     "example:\n"
+     "  tcbench check runs/quick tests/baselines/quick.json\n"},
+    {"version", cmd_version, 0, 0, 0, "",
+     "usage: tcbench version\n"
+     "\n"
+     "Prints the tcbench version and the git revision of its source tree.\n"
+     "\n"
+     "example:\n"
+     "  tcbench version\n"},
+    {"help", cmd_help, 0, 0, 1, "",
+     "usage: tcbench help [COMMAND]\n"
+     "\n"
+     "Prints the list of commands, or the help of one command.\n"
+     "\n"
+     "example:\n"
+     "  tcbench help run\n"},
+};
+#define N_COMMANDS ((int)(sizeof commands / sizeof commands[0]))
+
+static const char general_help[] =
+    "usage: tcbench [--plugin SO]... COMMAND [ARGS]\n"
+    "\n"
+    "A benchmark for temporally-coherent surface reconstruction and dense\n"
+    "correspondence on deforming 3-D shapes.\n"
+    "\n"
+    "commands:\n"
+    "  run       run the grid of a config (resumable)\n"
+    "  report    tables and plots from a run directory\n"
+    "  methods   list the registered methods\n"
+    "  datasets  list or export the synthetic sequences\n"
+    "  check     compare a run with a baseline (CI regression check)\n"
+    "  version   print the version\n"
+    "  help      help on a command\n"
+    "\n"
+    "'tcbench COMMAND --help' describes a command.\n"
+    "example:\n"
+    "  tcbench run configs/quick.json && tcbench report runs/quick\n";
+
+static const command *find_command(const char *name)
+{
+    for (int k = 0; k < N_COMMANDS; k++)
+        if (strcmp(commands[k].name, name) == 0) return &commands[k];
+    return NULL;
+}
+
+static int cmd_help(const cli *c)
+{
+    const command *cmd = c->n_args ? find_command(c->arg[0]) : NULL;
+    if (c->n_args && !cmd) return usage_error(NULL, "unknown command '%s'", c->arg[0]);
+    fputs(cmd ? cmd->help : general_help, stdout);
+    return 0;
+}
+
+/* ---- argument parsing ----------------------------------------------- */
+
+/* Parses argv[*i] (a flag) into c; advances *i past a separate value.
+ * `cmd` is NULL before the command name, where only global flags apply. */
+static int parse_flag(const command *cmd, int argc, char **argv, int *i, cli *c)
+{
+    char name[64];
+    const char *arg = argv[*i], *eq = strchr(arg, '=');
+    size_t len = eq ? (size_t)(eq - arg) : strlen(arg);
+    snprintf(name, sizeof name, "%.*s", (int)len, arg);
+    if (strcmp(name, "-h") == 0) snprintf(name, sizeof name, "--help");
+    int f = 0;
+    while (f < F_COUNT && strcmp(flags[f].name, name) != 0) f++;
+    unsigned accepted = BIT(F_PLUGIN) | BIT(F_HELP) | (cmd ? cmd->accepts : 0);
+    const char *where = cmd ? cmd->name : NULL;
+    if (f == F_COUNT || !(accepted & BIT(f))) return usage_error(where, "unknown option '%s'", name);
+    const char *value = NULL;
+    if (flags[f].takes_value) {
+        value = eq ? eq + 1 : *i + 1 < argc ? argv[++*i] : NULL;
+        if (!value) return usage_error(where, "option '%s' needs a value", name);
+    } else if (eq) {
+        return usage_error(where, "option '%s' takes no value", name);
+    }
+    if (f == F_PLUGIN) {
+        if (c->n_plugins == MAX_PLUGINS) return usage_error(where, "too many %s options", name);
+        c->plugins[c->n_plugins++] = value;
+    }
+    c->set[f] = 1;
+    c->value[f] = value;
+    return 0;
+}
+
+static int parse_command_args(const command *cmd, int argc, char **argv, int i, cli *c)
+{
+    int only_args = 0;
+    for (; i < argc; i++) {
+        const char *a = argv[i];
+        if (!only_args && strcmp(a, "--") == 0) {
+            only_args = 1;
+        } else if (!only_args && a[0] == '-' && a[1]) {
+            int rc = parse_flag(cmd, argc, argv, &i, c);
+            if (rc) return rc;
+        } else if (c->n_args == cmd->max_args) {
+            return usage_error(cmd->name, "unexpected argument '%s'", a);
+        } else {
+            c->arg[c->n_args++] = a;
+        }
+    }
+    if (!c->set[F_HELP] && c->n_args < cmd->min_args)
+        return usage_error(cmd->name, "missing %s", cmd->arg_names);
+    return 0;
+}
+
+static int load_plugins(const cli *c)
+{
+    for (int k = 0; k < c->n_plugins; k++) {
+        tcb_error err = {0};
+        if (tcb_registry_load_plugin(c->plugins[k], &err)) return fail(&err);
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    cli c = {0};
+    int i = 1, rc;
+    /* Global flags (--plugin, --help) may precede the command. */
+    for (; i < argc && argv[i][0] == '-'; i++)
+        if ((rc = parse_flag(NULL, argc, argv, &i, &c))) return rc;
+    if (i == argc) {
+        fputs(general_help, c.set[F_HELP] ? stdout : stderr);
+        return c.set[F_HELP] ? 0 : 2;
+    }
+    const command *cmd = find_command(argv[i]);
+    if (!cmd) return usage_error(NULL, "unknown command '%s'", argv[i]);
+    if ((rc = parse_command_args(cmd, argc, argv, i + 1, &c))) return rc;
+    if (c.set[F_HELP]) {
+        fputs(cmd->help, stdout);
+        return 0;
+    }
+    if ((rc = load_plugins(&c))) return rc;
+    return cmd->fn(&c);
+}

@@ -1,0 +1,238 @@
+/* The results store: cell paths and the writer of "tcbench-cell/1" files. */
+#include "tcb/results.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness/results_format.h"
+#include "tcb/fsutil.h"
+#include "tcb/json.h"
+#include "tcb/tcb.h"
+
+const char *const tcb_cell_status_names[] = {"ok", "failed", "diverged", NULL};
+const char *const tcb_cell_role_names[] = {"train", "validation", "test", NULL};
+const char *const tcb_cell_pair_columns[] = {"i",       "j",     "n",        "sl2",
+                                             "sl2_m2",  "sl2sq", "sl2sq_m2", "rank",
+                                             "rank_m2", "auc",   "cd",       NULL};
+
+const char *tcb_cell_status_name(tcb_cell_status s)
+{
+    return s >= TCB_CELL_OK && s <= TCB_CELL_DIVERGED ? tcb_cell_status_names[s] : "unknown";
+}
+
+/* A path component must not escape its directory. */
+static int check_component(const char *what, const char *name, tcb_error *err)
+{
+    if (!name[0] || strchr(name, '/') || !strcmp(name, ".") || !strcmp(name, ".."))
+        return tcb_fail(err, TCB_ERR_INPUT, "invalid %s name \"%s\" for a results path", what,
+                        name);
+    return TCB_OK;
+}
+
+int tcb_cell_path(char *out, size_t size, const char *run_dir, const char *dataset,
+                  const char *sequence, const char *method, int seed, tcb_error *err)
+{
+    int rc;
+    if ((rc = check_component("dataset", dataset, err)) ||
+        (rc = check_component("sequence", sequence, err)) ||
+        (rc = check_component("method", method, err)))
+        return rc;
+    return tcb_path_join(out, size, err, "%s/cells/%s/%s/%s/seed_%d.json", run_dir, dataset,
+                         sequence, method, seed);
+}
+
+/* cJSON builders report allocation failure by returning NULL; `ok` collects
+ * it so the writer stays a flat list of fields. */
+typedef struct builder {
+    int ok;
+} builder;
+
+static cJSON *add(builder *b, cJSON *obj, const char *key, cJSON *item)
+{
+    if (!item) {
+        b->ok = 0;
+        return NULL;
+    }
+    if (!cJSON_AddItemToObject(obj, key, item)) {
+        cJSON_Delete(item);
+        b->ok = 0;
+        return NULL;
+    }
+    return item;
+}
+
+/* cJSON prints 15 significant digits whenever they come within an ulp or
+ * so; a results file must give back the very bits, so print the shortest
+ * of %.15g … %.17g that does. */
+static cJSON *num_or_null(double x)
+{
+    if (!isfinite(x)) return cJSON_CreateNull();
+    char buf[32];
+    for (int digits = 15; digits <= 17; digits++) {
+        snprintf(buf, sizeof buf, "%.*g", digits, x);
+        if (strtod(buf, NULL) == x) break;
+    }
+    return cJSON_CreateRaw(buf);
+}
+
+static void add_num(builder *b, cJSON *obj, const char *key, double x)
+{
+    add(b, obj, key, num_or_null(x));
+}
+
+static void add_str(builder *b, cJSON *obj, const char *key, const char *s)
+{
+    add(b, obj, key, cJSON_CreateString(s));
+}
+
+static int append(builder *b, cJSON *arr, cJSON *item)
+{
+    if (!item || !cJSON_AddItemToArray(arr, item)) {
+        cJSON_Delete(item);
+        return b->ok = 0;
+    }
+    return 1;
+}
+
+static void add_stat(builder *b, cJSON *obj, const char *key, const tcb_stat *s)
+{
+    cJSON *o = add(b, obj, key, cJSON_CreateObject());
+    if (!o) return;
+    add_num(b, o, "n", s->n);
+    add_num(b, o, "mean", s->mean);
+    add_num(b, o, "m2", s->m2);
+}
+
+static void add_summary(builder *b, cJSON *root, const tcb_summary *s)
+{
+    cJSON *o = add(b, root, "summary", cJSON_CreateObject());
+    if (!o) return;
+    add_num(b, o, "n_pairs", s->n_pairs);
+    add_stat(b, o, "sl2", &s->sl2);
+    add_stat(b, o, "sl2sq", &s->sl2sq);
+    add_stat(b, o, "rank", &s->rank);
+    add_stat(b, o, "auc", &s->auc);
+    if (s->cd.n > 0)
+        add_stat(b, o, "cd", &s->cd);
+    else
+        add(b, o, "cd", cJSON_CreateNull());
+    cJSON *pck = add(b, o, "pck", cJSON_CreateArray());
+    for (int k = 0; pck && k < TCB_PCK_STEPS; k++) append(b, pck, num_or_null(s->pck[k]));
+}
+
+/* pairs: [n_pairs][TCB_N_PAIR_COLUMNS] in tcb_cell_pair_columns order. */
+static void add_pairs(builder *b, cJSON *root, const tcb_cell_result *c)
+{
+    cJSON *cols = add(b, root, "pair_columns", cJSON_CreateStringArray(tcb_cell_pair_columns,
+                                                                       TCB_N_PAIR_COLUMNS));
+    cJSON *rows = add(b, root, "pairs", cJSON_CreateArray());
+    if (!cols || !rows) return;
+    for (int p = 0; p < c->n_pairs && b->ok; p++) {
+        const tcb_pair_record *r = &c->pairs[p];
+        const double v[TCB_N_PAIR_COLUMNS] = {r->i,         r->j,          r->sl2.n,
+                                              r->sl2.mean,  r->sl2.m2,     r->sl2sq.mean,
+                                              r->sl2sq.m2,  r->rank.mean,  r->rank.m2,
+                                              r->auc,       r->cd};
+        cJSON *row = cJSON_CreateArray();
+        if (!append(b, rows, row)) return;
+        for (int k = 0; k < TCB_N_PAIR_COLUMNS; k++) append(b, row, num_or_null(v[k]));
+    }
+}
+
+static int check_for_save(const char *path, const tcb_cell_result *c, tcb_error *err)
+{
+    if (c->status < TCB_CELL_OK || c->status > TCB_CELL_DIVERGED)
+        return tcb_fail(err, TCB_ERR_INTERNAL, "%s: invalid cell status %d", path, (int)c->status);
+    if (c->n_pairs < 0 || (c->n_pairs > 0 && !c->pairs))
+        return tcb_fail(err, TCB_ERR_INTERNAL, "%s: %d pairs without records", path, c->n_pairs);
+    if ((double)c->split_seed > TCB_JSON_INT_MAX)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: split seed %llu exceeds 2^53", path,
+                        c->split_seed);
+    int role_known = 0;
+    for (int k = 0; tcb_cell_role_names[k]; k++)
+        role_known |= !strcmp(c->role, tcb_cell_role_names[k]);
+    if (!role_known)
+        return tcb_fail(err, TCB_ERR_INTERNAL, "%s: invalid role \"%s\"", path, c->role);
+    /* One "n" column serves the three per-vertex statistics of a pair. */
+    for (int p = 0; p < c->n_pairs; p++) {
+        const tcb_pair_record *r = &c->pairs[p];
+        if (r->sl2sq.n != r->sl2.n || r->rank.n != r->sl2.n)
+            return tcb_fail(err, TCB_ERR_INTERNAL, "%s: pair %d: statistics disagree on n",
+                            path, p);
+    }
+    return TCB_OK;
+}
+
+static cJSON *cell_to_json(const char *path, const tcb_cell_result *c, tcb_error *err)
+{
+    cJSON *params = cJSON_Parse(c->params_json ? c->params_json : "{}");
+    if (!cJSON_IsObject(params)) {
+        cJSON_Delete(params);
+        tcb_fail(err, TCB_ERR_INPUT, "%s: params: not a JSON object: %.200s", path,
+                 c->params_json);
+        return NULL;
+    }
+    builder b = {1};
+    cJSON *root = cJSON_CreateObject();
+    if (!root) {
+        cJSON_Delete(params);
+        tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", path);
+        return NULL;
+    }
+    add_str(&b, root, "format", TCB_CELL_FORMAT);
+    add_str(&b, root, "dataset", c->dataset);
+    add_str(&b, root, "sequence", c->sequence);
+    add_str(&b, root, "role", c->role);
+    add_str(&b, root, "method", c->method);
+    add_str(&b, root, "method_impl", c->method_impl);
+    add(&b, root, "params", params);
+    add_num(&b, root, "seed", c->seed);
+    add_str(&b, root, "status", tcb_cell_status_name(c->status));
+    add_str(&b, root, "message", c->message);
+    add_str(&b, root, "git_revision", c->git_revision);
+    add_str(&b, root, "tcbench_version", TCB_VERSION);
+    cJSON *t = add(&b, root, "timings", cJSON_CreateObject());
+    if (t) {
+        add_num(&b, t, "load_s", c->load_s);
+        add_num(&b, t, "fit_s", c->fit_s);
+        add_num(&b, t, "eval_s", c->eval_s);
+    }
+    add_num(&b, root, "peak_rss_kb", (double)c->peak_rss_kb);
+    cJSON *sp = add(&b, root, "split", cJSON_CreateObject());
+    if (sp) {
+        add_str(&b, sp, "path", c->split_path);
+        add_num(&b, sp, "seed", (double)c->split_seed);
+        add_num(&b, sp, "n_pairs", c->n_pairs);
+    }
+    add_summary(&b, root, &c->summary);
+    add_pairs(&b, root, c);
+    if (!b.ok) {
+        cJSON_Delete(root);
+        tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", path);
+        return NULL;
+    }
+    return root;
+}
+
+int tcb_cell_save(const char *path, const tcb_cell_result *c, tcb_error *err)
+{
+    int rc = check_for_save(path, c, err);
+    if (rc) return rc;
+    cJSON *root = cell_to_json(path, c, err);
+    if (!root) return err ? (int)err->code : TCB_ERR_INPUT;
+    rc = tcb_json_save(path, root, err);
+    cJSON_Delete(root);
+    return rc;
+}
+
+void tcb_cell_free(tcb_cell_result *c)
+{
+    if (!c) return;
+    free(c->params_json);
+    free(c->pairs);
+    c->params_json = NULL;
+    c->pairs = NULL;
+    c->n_pairs = 0;
+}

@@ -1,0 +1,306 @@
+/* The reader of "tcbench-cell/1" files: every field validated, errors
+ * naming the file and the key. */
+#include "tcb/results.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness/results_format.h"
+#include "tcb/json.h"
+
+static const char *const TOP_KEYS[] = {
+    "format",       "dataset",         "sequence", "role",        "method",
+    "method_impl",  "params",          "seed",     "status",      "message",
+    "git_revision", "tcbench_version", "timings",  "peak_rss_kb", "split",
+    "summary",      "pair_columns",    "pairs",    NULL};
+static const char *const TIMING_KEYS[] = {"load_s", "fit_s", "eval_s", NULL};
+static const char *const SPLIT_KEYS[] = {"path", "seed", "n_pairs", NULL};
+static const char *const SUMMARY_KEYS[] = {"n_pairs", "sl2", "sl2sq", "rank",
+                                           "auc",     "cd",  "pck",   NULL};
+static const char *const STAT_KEYS[] = {"n", "mean", "m2", NULL};
+
+/* Key paths for messages ("file: summary.sl2.mean"); a path too long for
+ * the buffer is cut, which only shortens a message. */
+__attribute__((format(printf, 3, 4))) static void key_path(char *out, size_t size,
+                                                           const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(out, size, fmt, ap);
+    va_end(ap);
+}
+
+/* A float metric: a number, or null for a non-finite value. */
+static int value_or_null(const cJSON *item, const char *where, double *out, tcb_error *err)
+{
+    if (cJSON_IsNull(item)) {
+        *out = NAN;
+        return TCB_OK;
+    }
+    if (!cJSON_IsNumber(item))
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: expected a number or null", where);
+    *out = item->valuedouble;
+    return TCB_OK;
+}
+
+static int num_or_null_key(const cJSON *obj, const char *key, const char *where, double *out,
+                           tcb_error *err)
+{
+    char at[TCB_ERRMSG_MAX];
+    key_path(at, sizeof at, "%s.%s", where, key);
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!item) return tcb_fail(err, TCB_ERR_INPUT, "%s: missing key", at);
+    return value_or_null(item, at, out, err);
+}
+
+/* A required sub-object with exactly the allowed keys; *where gets its path. */
+static int object_key(const cJSON *obj, const char *key, const char *where,
+                      const char *const *allowed, const cJSON **out, char *sub, size_t sub_size,
+                      tcb_error *err)
+{
+    key_path(sub, sub_size, "%s.%s", where, key);
+    *out = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!*out) return tcb_fail(err, TCB_ERR_INPUT, "%s: missing key", sub);
+    int rc = tcb_json_expect_object(*out, sub, err);
+    return rc ? rc : tcb_json_expect_keys(*out, sub, allowed, err);
+}
+
+static int copy_str(const cJSON *obj, const char *key, const char *where, char *dst,
+                    size_t size, tcb_error *err)
+{
+    const char *s;
+    int rc = tcb_json_str(obj, key, where, 1, NULL, &s, err);
+    if (rc) return rc;
+    if (strlen(s) >= size)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: longer than %zu characters", where, key,
+                        size - 1);
+    memcpy(dst, s, strlen(s) + 1);
+    return TCB_OK;
+}
+
+static int load_stat(const cJSON *obj, const char *key, const char *where, tcb_stat *s,
+                     tcb_error *err)
+{
+    char sub[TCB_ERRMSG_MAX];
+    const cJSON *o;
+    int rc = object_key(obj, key, where, STAT_KEYS, &o, sub, sizeof sub, err);
+    if (rc) return rc;
+    if ((rc = tcb_json_num(o, "n", sub, 1, 0, 0, INFINITY, &s->n, err))) return rc;
+    if ((rc = num_or_null_key(o, "mean", sub, &s->mean, err))) return rc;
+    return num_or_null_key(o, "m2", sub, &s->m2, err);
+}
+
+static int load_summary(const cJSON *root, const char *where, tcb_summary *s, tcb_error *err)
+{
+    char sub[TCB_ERRMSG_MAX];
+    const cJSON *o;
+    long long n;
+    int rc = object_key(root, "summary", where, SUMMARY_KEYS, &o, sub, sizeof sub, err);
+    if (rc || (rc = tcb_json_int(o, "n_pairs", sub, 1, 0, 0, INT_MAX, &n, err))) return rc;
+    s->n_pairs = (int)n;
+    if ((rc = load_stat(o, "sl2", sub, &s->sl2, err)) ||
+        (rc = load_stat(o, "sl2sq", sub, &s->sl2sq, err)) ||
+        (rc = load_stat(o, "rank", sub, &s->rank, err)) ||
+        (rc = load_stat(o, "auc", sub, &s->auc, err)))
+        return rc;
+    const cJSON *cd = cJSON_GetObjectItemCaseSensitive(o, "cd");
+    if (cJSON_IsNull(cd))
+        s->cd = (tcb_stat){0, 0, 0};
+    else if ((rc = load_stat(o, "cd", sub, &s->cd, err)))
+        return rc;
+    const cJSON *pck = cJSON_GetObjectItemCaseSensitive(o, "pck");
+    if (!cJSON_IsArray(pck) || cJSON_GetArraySize(pck) != TCB_PCK_STEPS)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.pck: expected an array of %d numbers", sub,
+                        TCB_PCK_STEPS);
+    int k = 0;
+    for (const cJSON *v = pck->child; v; v = v->next, k++) {
+        char at[TCB_ERRMSG_MAX];
+        key_path(at, sizeof at, "%s.pck[%d]", sub, k);
+        if ((rc = value_or_null(v, at, &s->pck[k], err))) return rc;
+    }
+    return TCB_OK;
+}
+
+static int load_pair_columns(const cJSON *root, const char *where, tcb_error *err)
+{
+    const cJSON *cols = cJSON_GetObjectItemCaseSensitive(root, "pair_columns");
+    int ok = cJSON_IsArray(cols) && cJSON_GetArraySize(cols) == TCB_N_PAIR_COLUMNS;
+    int k = 0;
+    for (const cJSON *c = ok ? cols->child : NULL; c; c = c->next, k++)
+        ok = ok && cJSON_IsString(c) && !strcmp(c->valuestring, tcb_cell_pair_columns[k]);
+    if (!ok)
+        return tcb_fail(err, TCB_ERR_INPUT,
+                        "%s.pair_columns: expected [\"i\", \"j\", \"n\", \"sl2\", …, \"cd\"] "
+                        "(%d columns of format %s)",
+                        where, TCB_N_PAIR_COLUMNS, TCB_CELL_FORMAT);
+    return TCB_OK;
+}
+
+static int pair_index(const cJSON *v, const char *at, int *out, tcb_error *err)
+{
+    if (!cJSON_IsNumber(v) || v->valuedouble < 0 || v->valuedouble > INT_MAX ||
+        v->valuedouble != floor(v->valuedouble))
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: expected a frame index", at);
+    *out = (int)v->valuedouble;
+    return TCB_OK;
+}
+
+static int load_pair(const cJSON *row, const char *at, tcb_pair_record *r, tcb_error *err)
+{
+    if (!cJSON_IsArray(row) || cJSON_GetArraySize(row) != TCB_N_PAIR_COLUMNS)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: expected an array of %d values", at,
+                        TCB_N_PAIR_COLUMNS);
+    const cJSON *v = row->child;
+    int rc;
+    if ((rc = pair_index(v, at, &r->i, err))) return rc;
+    if ((rc = pair_index(v->next, at, &r->j, err))) return rc;
+    double x[TCB_N_PAIR_COLUMNS - 2]; /* n, sl2, sl2_m2, sl2sq, sl2sq_m2, rank, rank_m2, auc, cd */
+    int k = 0;
+    for (v = v->next->next; v; v = v->next, k++)
+        if ((rc = value_or_null(v, at, &x[k], err))) return rc;
+    if (!(x[0] >= 0)) return tcb_fail(err, TCB_ERR_INPUT, "%s: n must be >= 0", at);
+    r->sl2 = (tcb_stat){x[0], x[1], x[2]};
+    r->sl2sq = (tcb_stat){x[0], x[3], x[4]};
+    r->rank = (tcb_stat){x[0], x[5], x[6]};
+    r->auc = x[7];
+    r->cd = x[8];
+    return TCB_OK;
+}
+
+static int load_pairs(const cJSON *root, const char *where, tcb_cell_result *c, tcb_error *err)
+{
+    const cJSON *rows = cJSON_GetObjectItemCaseSensitive(root, "pairs");
+    if (!cJSON_IsArray(rows))
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.pairs: expected an array", where);
+    if (cJSON_GetArraySize(rows) != c->n_pairs)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.pairs: %d rows, but split.n_pairs is %d", where,
+                        cJSON_GetArraySize(rows), c->n_pairs);
+    if (c->n_pairs == 0) return TCB_OK;
+    c->pairs = calloc((size_t)c->n_pairs, sizeof *c->pairs);
+    if (!c->pairs) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", where);
+    int p = 0;
+    for (const cJSON *row = rows->child; row; row = row->next, p++) {
+        char at[TCB_ERRMSG_MAX];
+        key_path(at, sizeof at, "%s.pairs[%d]", where, p);
+        int rc = load_pair(row, at, &c->pairs[p], err);
+        if (rc) return rc;
+    }
+    return TCB_OK;
+}
+
+static int load_params(const cJSON *root, const char *where, tcb_cell_result *c, tcb_error *err)
+{
+    char sub[TCB_ERRMSG_MAX];
+    key_path(sub, sizeof sub, "%s.params", where);
+    const cJSON *params = cJSON_GetObjectItemCaseSensitive(root, "params");
+    if (!params) return tcb_fail(err, TCB_ERR_INPUT, "%s: missing key", sub);
+    int rc = tcb_json_expect_object(params, sub, err);
+    if (rc) return rc;
+    char *text = cJSON_PrintUnformatted(params);
+    c->params_json = text ? strdup(text) : NULL;
+    cJSON_free(text);
+    return c->params_json ? TCB_OK : tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", sub);
+}
+
+static int load_header(const cJSON *root, const char *where, tcb_cell_result *c, tcb_error *err)
+{
+    const char *format;
+    int idx, rc;
+    long long v;
+    if ((rc = tcb_json_str(root, "format", where, 1, NULL, &format, err))) return rc;
+    if (strcmp(format, TCB_CELL_FORMAT))
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.format: \"%s\" is not \"%s\"", where, format,
+                        TCB_CELL_FORMAT);
+    if ((rc = tcb_json_expect_keys(root, where, TOP_KEYS, err)) ||
+        (rc = copy_str(root, "dataset", where, c->dataset, sizeof c->dataset, err)) ||
+        (rc = copy_str(root, "sequence", where, c->sequence, sizeof c->sequence, err)) ||
+        (rc = tcb_json_enum(root, "role", where, 1, 0, tcb_cell_role_names, &idx, err)))
+        return rc;
+    strcpy(c->role, tcb_cell_role_names[idx]);
+    if ((rc = copy_str(root, "method", where, c->method, sizeof c->method, err)) ||
+        (rc = copy_str(root, "method_impl", where, c->method_impl, sizeof c->method_impl, err)) ||
+        (rc = tcb_json_int(root, "seed", where, 1, 0, INT_MIN, INT_MAX, &v, err)))
+        return rc;
+    c->seed = (int)v;
+    if ((rc = tcb_json_enum(root, "status", where, 1, 0, tcb_cell_status_names, &idx, err)))
+        return rc;
+    c->status = (tcb_cell_status)idx;
+    const char *version;
+    if ((rc = copy_str(root, "message", where, c->message, sizeof c->message, err)) ||
+        (rc = copy_str(root, "git_revision", where, c->git_revision, sizeof c->git_revision,
+                       err)) ||
+        (rc = tcb_json_str(root, "tcbench_version", where, 1, NULL, &version, err)) ||
+        (rc = tcb_json_int(root, "peak_rss_kb", where, 1, 0, 0, (long long)TCB_JSON_INT_MAX, &v,
+                           err)))
+        return rc;
+    c->peak_rss_kb = (long)v;
+    return TCB_OK;
+}
+
+static int load_timings_split(const cJSON *root, const char *where, tcb_cell_result *c,
+                              tcb_error *err)
+{
+    char sub[TCB_ERRMSG_MAX];
+    const cJSON *o;
+    long long v;
+    int rc;
+    if ((rc = object_key(root, "timings", where, TIMING_KEYS, &o, sub, sizeof sub, err)) ||
+        (rc = tcb_json_num(o, "load_s", sub, 1, 0, 0, INFINITY, &c->load_s, err)) ||
+        (rc = tcb_json_num(o, "fit_s", sub, 1, 0, 0, INFINITY, &c->fit_s, err)) ||
+        (rc = tcb_json_num(o, "eval_s", sub, 1, 0, 0, INFINITY, &c->eval_s, err)))
+        return rc;
+    if ((rc = object_key(root, "split", where, SPLIT_KEYS, &o, sub, sizeof sub, err)) ||
+        (rc = copy_str(o, "path", sub, c->split_path, sizeof c->split_path, err)) ||
+        (rc = tcb_json_int(o, "seed", sub, 1, 0, 0, (long long)TCB_JSON_INT_MAX, &v, err)))
+        return rc;
+    c->split_seed = (unsigned long long)v;
+    if ((rc = tcb_json_int(o, "n_pairs", sub, 1, 0, 0, INT_MAX, &v, err))) return rc;
+    c->n_pairs = (int)v;
+    return TCB_OK;
+}
+
+static int cell_from_json(const cJSON *root, const char *path, tcb_cell_result *c,
+                          tcb_error *err)
+{
+    int rc = tcb_json_expect_object(root, path, err);
+    if (rc || (rc = load_header(root, path, c, err)) || (rc = load_params(root, path, c, err)) ||
+        (rc = load_timings_split(root, path, c, err)) ||
+        (rc = load_summary(root, path, &c->summary, err)) ||
+        (rc = load_pair_columns(root, path, err)) || (rc = load_pairs(root, path, c, err)))
+        return rc;
+    /* A finished ok cell scored every pair of its split. */
+    if (c->status == TCB_CELL_OK && c->summary.n_pairs != c->n_pairs)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.summary.n_pairs: %d, but the cell has %d pairs",
+                        path, c->summary.n_pairs, c->n_pairs);
+    return TCB_OK;
+}
+
+/* The JSON helpers join `where` and a key with '.'; at the top level that
+ * reads "seed_0.json.status", so make it "seed_0.json: status". */
+static void fix_top(const char *path, tcb_error *err)
+{
+    size_t n = strlen(path);
+    if (!err || strncmp(err->msg, path, n) || err->msg[n] != '.') return;
+    char rest[TCB_ERRMSG_MAX];
+    snprintf(rest, sizeof rest, "%s", err->msg + n + 1);
+    key_path(err->msg, sizeof err->msg, "%s: %s", path, rest);
+}
+
+int tcb_cell_load(const char *path, tcb_cell_result *out, tcb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    cJSON *root;
+    int rc = tcb_json_load(path, &root, err);
+    if (rc) return rc;
+    rc = cell_from_json(root, path, out, err);
+    cJSON_Delete(root);
+    if (rc) {
+        fix_top(path, err);
+        tcb_cell_free(out);
+    }
+    return rc;
+}

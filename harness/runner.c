@@ -1,0 +1,328 @@
+/* The grid runner: datasets × sequences × methods × seeds.
+ *
+ * Each sequence is loaded once and its split obtained once; then every
+ * (method, seed) cell either is skipped (its file exists and was made with
+ * the same settings) or is computed by tcb_cell_run and saved atomically.
+ * Everything a cell computes is a function of the config and the seed, so a
+ * killed run, rerun, produces the same cell files as an uninterrupted one. */
+#include "tcb/runner.h"
+
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness/internal.h"
+#include "tcb/fsutil.h"
+#include "tcb/registry.h"
+#include "tcb/synth.h"
+
+/* What the grid loop carries from one sequence to the next. */
+typedef struct run_state {
+    const tcb_config *cfg;
+    const tcb_run_opts *opts;
+    const char *run_dir;
+    char git_revision[64];
+    tcb_run_stats *stats;
+} run_state;
+
+/* Unlinks "<path>.tmp-*" left by a writer killed before its rename: a
+ * resumed run must not leave debris that a finished run would not have. */
+static void remove_stale_temps(const char *path)
+{
+    char dir[TCB_PATH_MAX];
+    snprintf(dir, sizeof dir, "%s", path);
+    char *slash = strrchr(dir, '/');
+    const char *base = slash ? slash + 1 : path;
+    if (slash) *slash = '\0';
+    char prefix[TCB_PATH_MAX];
+    snprintf(prefix, sizeof prefix, "%s.tmp-", base);
+    DIR *d = opendir(slash ? dir : ".");
+    if (!d) return;
+    for (struct dirent *e; (e = readdir(d));) {
+        char victim[TCB_PATH_MAX];
+        if (strncmp(e->d_name, prefix, strlen(prefix)) != 0) continue;
+        if ((size_t)snprintf(victim, sizeof victim, "%s/%s", slash ? dir : ".", e->d_name) <
+            sizeof victim)
+            remove(victim);
+    }
+    closedir(d);
+}
+
+static int load_plugins(const tcb_config *cfg, tcb_error *err)
+{
+    for (int k = 0; k < cfg->n_plugins; k++) {
+        int rc = tcb_registry_load_plugin(cfg->plugins[k], err);
+        if (rc) {
+            tcb_error_prefix(err, "%s: plugins[%d]: ", cfg->path, k);
+            return rc;
+        }
+    }
+    return TCB_OK;
+}
+
+static const tcb_method_spec *find_label(const tcb_config *cfg, const char *label)
+{
+    for (int k = 0; k < cfg->n_methods; k++)
+        if (strcmp(cfg->methods[k].label, label) == 0) return &cfg->methods[k];
+    return NULL;
+}
+
+static int selected(const tcb_run_opts *opts, const tcb_method_spec *m)
+{
+    return !opts->only_method || strcmp(opts->only_method, m->label) == 0;
+}
+
+/* Every selected method must exist and accept its params before any work
+ * starts: a typo should cost seconds, not the hours of the cells before it. */
+static int check_methods(const tcb_config *cfg, const tcb_run_opts *opts, tcb_error *err)
+{
+    if (opts->only_method && !find_label(cfg, opts->only_method))
+        return tcb_fail(err, TCB_ERR_INPUT, "--only: %s has no method labelled '%s'", cfg->path,
+                        opts->only_method);
+    for (int k = 0; k < cfg->n_methods; k++) {
+        const tcb_method_spec *m = &cfg->methods[k];
+        if (!selected(opts, m)) continue;
+        const tcb_method_ops *ops = tcb_registry_find(m->method);
+        if (!ops) {
+            char list[1024] = "";
+            for (int r = 0; r < tcb_registry_count(); r++) {
+                size_t used = strlen(list);
+                snprintf(list + used, sizeof list - used, "%s%s", r ? ", " : "",
+                         tcb_registry_get(r)->name);
+            }
+            return tcb_fail(err, TCB_ERR_INPUT,
+                            "%s: methods[%d]: no method named '%s' (registered: %s)", cfg->path, k,
+                            m->method, list);
+        }
+        void *self = NULL;
+        int rc = ops->create(m->params_json, &self, err);
+        if (rc) {
+            tcb_error_prefix(err, "%s: methods[%d].params: ", cfg->path, k);
+            return rc;
+        }
+        ops->destroy(self);
+    }
+    return TCB_OK;
+}
+
+static int write_config(const run_state *st, tcb_error *err)
+{
+    char path[TCB_PATH_MAX];
+    int rc = tcb_path_join(path, sizeof path, err, "%s/config.json", st->run_dir);
+    if (rc) return rc;
+    remove_stale_temps(path);
+    size_t len = strlen(st->cfg->json_text);
+    char *text = malloc(len + 2);
+    if (!text) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
+    memcpy(text, st->cfg->json_text, len);
+    text[len] = '\n';
+    text[len + 1] = '\0';
+    rc = tcb_write_file_atomic(path, text, len + 1, err);
+    free(text);
+    return rc;
+}
+
+/* Synthetic: generate, normalize, sample pools. Objdir: the cached loader. */
+static int load_sequence(const run_state *st, const tcb_dataset_spec *d, const char *name,
+                         tcb_sequence *seq, tcb_error *err)
+{
+    const tcb_config *cfg = st->cfg;
+    int rc;
+    if (d->source == TCB_SOURCE_SYNTHETIC) {
+        rc = tcb_synth_generate(name, d->seed, d->frames, seq, err);
+        if (!rc) rc = tcb_sequence_normalize(seq, d->norm, err);
+        if (!rc) rc = tcb_sequence_sample_pools(seq, cfg->pool_size, cfg->pool_seed, err);
+    } else {
+        char dir[TCB_PATH_MAX];
+        rc = tcb_path_join(dir, sizeof dir, err, "%s/%s", d->root, name);
+        if (!rc && !tcb_is_dir(dir))
+            rc = tcb_fail(err, TCB_ERR_IO, "%s: no such directory", dir);
+        tcb_load_opts lo = {d->norm, cfg->pool_size, cfg->pool_seed,
+                            cfg->cache_dir[0] ? cfg->cache_dir : NULL};
+        if (!rc) rc = tcb_sequence_load_objdir(dir, name, &lo, seq, err);
+    }
+    if (rc) {
+        tcb_sequence_free(seq);
+        tcb_error_prefix(err, "dataset %s, sequence %s: ", d->name, name);
+        return rc;
+    }
+    seq->input_points = cfg->input_points;
+    seq->draw_with_replacement = d->with_replacement;
+    return TCB_OK;
+}
+
+/* <splits_dir>/<dataset>/<sequence>.json; tcb_split_obtain refuses a file
+ * made for other settings, so every method sees the same pairs. */
+static int obtain_split(const run_state *st, const tcb_dataset_spec *d,
+                        const tcb_sequence_spec *s, int n_frames, char *path, size_t size,
+                        tcb_split *split, tcb_error *err)
+{
+    const tcb_config *cfg = st->cfg;
+    int rc = tcb_path_join(path, size, err, "%s/%s/%s.json", cfg->splits_dir, d->name, s->name);
+    if (rc) return rc;
+    return tcb_split_obtain(path, d->name, s->name, s->role, n_frames, cfg->eval_pairs,
+                            cfg->split_seed, split, err);
+}
+
+/* An existing cell is reused only if it was made with the same method,
+ * params and split; otherwise the results directory would mix settings.
+ * (The split's path is not compared: the same split may be reached through
+ * another working directory.) */
+static int check_existing(const char *path, const tcb_method_spec *m, const tcb_split *split,
+                          tcb_error *err)
+{
+    tcb_cell_result c;
+    int rc = tcb_cell_load(path, &c, err);
+    if (rc) {
+        tcb_error_prefix(err, "cannot resume (rerun with --force to recompute): ");
+        return rc;
+    }
+    const char *what = strcmp(c.method_impl, m->method) != 0     ? "method"
+                       : strcmp(c.params_json, m->params_json) != 0 ? "params"
+                       : c.split_seed != split->seed               ? "split seed"
+                       : c.status == TCB_CELL_OK && c.n_pairs != split->n_pairs
+                           ? "number of pairs"
+                           : NULL;
+    tcb_cell_free(&c);
+    if (!what) return TCB_OK;
+    return tcb_fail(err, TCB_ERR_INPUT,
+                    "%s: was computed with another %s than the config's; rerun with --force to "
+                    "recompute, or use a new --out",
+                    path, what);
+}
+
+/* Shared by every cell of one sequence. */
+typedef struct seq_ctx {
+    const tcb_dataset_spec *dataset;
+    const tcb_sequence *seq;
+    const tcb_split *split;
+    const char *split_path;
+    double load_s;
+} seq_ctx;
+
+static int run_cell(const run_state *st, const seq_ctx *sc, const tcb_method_spec *m, int seed,
+                    const char *cell_path, tcb_error *err)
+{
+    char work[TCB_PATH_MAX], ckpt[TCB_PATH_MAX];
+    int rc = tcb_path_join(work, sizeof work, err, "%s/work/%s/%s/%s/seed_%d", st->run_dir,
+                           sc->dataset->name, sc->seq->name, m->label, seed);
+    if (!rc) rc = tcb_path_join(ckpt, sizeof ckpt, err, "%s/model.ckpt", work);
+    if (!rc) rc = tcb_mkdirs(work, err);
+    if (rc) return rc;
+    remove_stale_temps(ckpt);
+    remove_stale_temps(cell_path);
+    tcb_cell_job job = {
+        .seq = sc->seq,
+        .split = sc->split,
+        .split_path = sc->split_path,
+        .dataset = sc->dataset,
+        .method = m,
+        .ops = tcb_registry_find(m->method),
+        .seed = seed,
+        .threads = st->cfg->threads,
+        .reuse_checkpoint = !st->opts->force,
+        .work_dir = work,
+        .checkpoint = ckpt,
+        .git_revision = st->git_revision,
+        .load_s = sc->load_s,
+        .reporter = st->opts->reporter,
+    };
+    char label[TCB_CELL_LABEL_MAX];
+    tcb_cell_label(label, sizeof label, sc->dataset->name, sc->seq->name, m->label, seed);
+    tcb_cell_result cell;
+    rc = tcb_cell_run(&job, &cell, err);
+    if (rc) {
+        tcb_error_prefix(err, "%s: ", label);
+        return rc;
+    }
+    rc = tcb_cell_save(cell_path, &cell, err);
+    if (!rc && cell.status != TCB_CELL_OK) {
+        st->stats->cells_failed++;
+        tcb_report_log(&st->opts->reporter, TCB_LOG_WARN, "%s %s: %s", label,
+                       tcb_cell_status_name(cell.status), cell.message);
+    }
+    if (!rc) st->stats->cells_done++;
+    tcb_cell_free(&cell);
+    return rc;
+}
+
+static int run_cells(const run_state *st, const seq_ctx *sc, tcb_error *err)
+{
+    const tcb_config *cfg = st->cfg;
+    for (int k = 0; k < cfg->n_methods; k++) {
+        const tcb_method_spec *m = &cfg->methods[k];
+        if (!selected(st->opts, m)) continue;
+        for (int s = 0; s < cfg->n_seeds; s++) {
+            char path[TCB_PATH_MAX];
+            int rc = tcb_cell_path(path, sizeof path, st->run_dir, sc->dataset->name,
+                                   sc->seq->name, m->label, cfg->seeds[s], err);
+            st->stats->cells_total++;
+            if (!rc && !st->opts->force && tcb_is_file(path)) {
+                rc = check_existing(path, m, sc->split, err);
+                if (!rc) st->stats->cells_skipped++;
+            } else if (!rc) {
+                rc = run_cell(st, sc, m, cfg->seeds[s], path, err);
+            }
+            if (rc) return rc;
+        }
+    }
+    return TCB_OK;
+}
+
+static int run_sequence(const run_state *st, const tcb_dataset_spec *d, const tcb_sequence_spec *s,
+                        tcb_error *err)
+{
+    tcb_sequence seq = {0};
+    tcb_split split = {0};
+    char split_path[TCB_PATH_MAX];
+    double t0 = tcb_now_seconds();
+    tcb_report_log(&st->opts->reporter, TCB_LOG_INFO, "%s/%s: loading", d->name, s->name);
+    int rc = load_sequence(st, d, s->name, &seq, err);
+    if (rc) return rc;
+    seq_ctx sc = {d, &seq, &split, split_path, tcb_now_seconds() - t0};
+    rc = obtain_split(st, d, s, seq.n_frames, split_path, sizeof split_path, &split, err);
+    if (!rc) rc = run_cells(st, &sc, err);
+    tcb_split_free(&split);
+    tcb_sequence_free(&seq);
+    return rc;
+}
+
+static int root_missing(const tcb_dataset_spec *d)
+{
+    return d->source == TCB_SOURCE_OBJDIR && !tcb_is_dir(d->root);
+}
+
+/* Missing data is found before any cell runs, not hours into the run. */
+static int check_roots(const tcb_config *cfg, tcb_error *err)
+{
+    for (int k = 0; k < cfg->n_datasets; k++)
+        if (!cfg->datasets[k].optional && root_missing(&cfg->datasets[k]))
+            return tcb_fail(err, TCB_ERR_IO, "%s: datasets[%d].root: %s: no such directory",
+                            cfg->path, k, cfg->datasets[k].root);
+    return TCB_OK;
+}
+
+int tcb_run(const tcb_config *cfg, const tcb_run_opts *opts, tcb_run_stats *stats,
+            tcb_error *err)
+{
+    memset(stats, 0, sizeof *stats);
+    run_state st = {cfg, opts, opts->output ? opts->output : cfg->output, "", stats};
+    int rc = load_plugins(cfg, err);
+    if (!rc) rc = check_methods(cfg, opts, err);
+    if (!rc) rc = check_roots(cfg, err);
+    if (!rc) rc = write_config(&st, err);
+    if (rc) return rc;
+    tcb_git_revision(st.git_revision, sizeof st.git_revision);
+    for (int k = 0; k < cfg->n_datasets && !rc; k++) {
+        const tcb_dataset_spec *d = &cfg->datasets[k];
+        if (root_missing(d)) {
+            tcb_report_log(&opts->reporter, TCB_LOG_INFO,
+                           "dataset %s skipped: %s not found (optional)", d->name, d->root);
+            continue;
+        }
+        for (int s = 0; s < d->n_sequences && !rc; s++)
+            rc = run_sequence(&st, d, &d->sequences[s], err);
+    }
+    return rc;
+}

@@ -1,0 +1,335 @@
+/* Cells → blocks of rows → per-dataset MEAN blocks (reference-protocol §5.6). */
+#include "reports/aggregate.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const tcb_rpt_metric_def tcb_rpt_metrics[TCB_N_METRICS] = {
+    {"sl2", "m_sL2 ↓", "m\\_sL2 $\\downarrow$", 1e3, 2, 1},
+    {"rank", "rank ↓", "rank $\\downarrow$", 1e2, 2, 1},
+    {"auc", "AUC ↑", "AUC $\\uparrow$", 1e2, 2, 0},
+    /* %.3f as the authors' CSV: CD ×1e3 of good methods is ~0.09. */
+    {"cd", "CD ↓", "CD $\\downarrow$", 1e3, 3, 1},
+};
+
+static int same_block(const tcb_cell_result *a, const tcb_cell_result *b)
+{
+    return !strcmp(a->dataset, b->dataset) && !strcmp(a->sequence, b->sequence);
+}
+
+/* ------------------------------------------------------------ one row */
+
+static void set_stat(tcb_rpt_row *r, int m, const tcb_stat *s)
+{
+    r->has[m] = s->n > 0;
+    r->mean[m] = s->mean * tcb_rpt_metrics[m].scale;
+    r->std[m] = tcb_stat_std(s) * tcb_rpt_metrics[m].scale;
+}
+
+/* cells[0 .. n): one method of one block, ascending seeds. */
+static void build_row(const tcb_cell_result *cells, int n, tcb_rpt_row *r)
+{
+    memset(r, 0, sizeof *r);
+    snprintf(r->method, sizeof r->method, "%s", cells[0].method);
+    r->n_seeds = n;
+    r->status = "ok";
+    int n_bad = 0;
+    tcb_summary pooled;
+    tcb_summary_init(&pooled);
+    for (int k = 0; k < n; k++) {
+        const tcb_cell_result *c = &cells[k];
+        if (c->n_pairs > r->n_pairs) r->n_pairs = c->n_pairs;
+        if (c->status == TCB_CELL_OK) {
+            tcb_summary_merge(&pooled, &c->summary);
+        } else if (n_bad++ == 0) {
+            r->status = tcb_cell_status_name(c->status);
+            snprintf(r->message, sizeof r->message, "seed %d: %s", c->seed, c->message);
+        }
+    }
+    if (n_bad) {
+        if (n_bad == n)
+            snprintf(r->status_text, sizeof r->status_text, "%s", r->status);
+        else
+            snprintf(r->status_text, sizeof r->status_text, "%s (%d/%d seeds)", r->status, n_bad,
+                     n);
+        return;
+    }
+    snprintf(r->status_text, sizeof r->status_text, "ok");
+    set_stat(r, TCB_M_SL2, &pooled.sl2);
+    set_stat(r, TCB_M_RANK, &pooled.rank);
+    set_stat(r, TCB_M_AUC, &pooled.auc);
+    set_stat(r, TCB_M_CD, &pooled.cd);
+    r->sl2sq_mean = pooled.sl2sq.mean * 1e3;
+    r->sl2sq_std = tcb_stat_std(&pooled.sl2sq) * 1e3;
+    for (int s = 0; s < TCB_PCK_STEPS; s++) r->pck[s] = pooled.pck[s] * 100.0;
+}
+
+/* ------------------------------------------------------ best per column */
+
+/* The value as printed, so that equal-looking numbers tie. */
+static double displayed(double x, int decimals)
+{
+    char buf[64];
+    snprintf(buf, sizeof buf, "%.*f", decimals, x);
+    return strtod(buf, NULL);
+}
+
+static void mark_best(tcb_rpt_block *b)
+{
+    for (int m = 0; m < TCB_N_METRICS; m++) {
+        const tcb_rpt_metric_def *d = &tcb_rpt_metrics[m];
+        double best = d->lower_is_better ? INFINITY : -INFINITY;
+        for (int k = 0; k < b->n_rows; k++) {
+            if (!b->rows[k].has[m]) continue;
+            double v = displayed(b->rows[k].mean[m], d->decimals);
+            if (d->lower_is_better ? v < best : v > best) best = v;
+        }
+        for (int k = 0; k < b->n_rows; k++)
+            b->rows[k].best[m] =
+                b->rows[k].has[m] && displayed(b->rows[k].mean[m], d->decimals) == best;
+    }
+}
+
+/* Pair-count range over the rows that scored pairs (a failed cell may have
+ * none), and the best marks, once the rows are in place. */
+static void finish_block(tcb_rpt_block *b)
+{
+    int any_ok = 0;
+    for (int k = 0; k < b->n_rows; k++) any_ok |= !strcmp(b->rows[k].status, "ok");
+    b->n_pairs_min = INT_MAX;
+    b->n_pairs_max = 0;
+    for (int k = 0; k < b->n_rows; k++) {
+        const tcb_rpt_row *r = &b->rows[k];
+        if (any_ok && strcmp(r->status, "ok")) continue;
+        if (r->n_pairs < b->n_pairs_min) b->n_pairs_min = r->n_pairs;
+        if (r->n_pairs > b->n_pairs_max) b->n_pairs_max = r->n_pairs;
+    }
+    mark_best(b);
+}
+
+/* ----------------------------------------------------------- one block */
+
+static int cmp_int(const void *a, const void *b)
+{
+    int x = *(const int *)a, y = *(const int *)b;
+    return (x > y) - (x < y);
+}
+
+static int block_seeds(const tcb_cell_result *cells, int n, tcb_rpt_block *b, tcb_error *err)
+{
+    int *seeds = malloc((size_t)n * sizeof *seeds);
+    if (!seeds) return tcb_fail(err, TCB_ERR_NOMEM, "report: out of memory");
+    for (int k = 0; k < n; k++) seeds[k] = cells[k].seed;
+    qsort(seeds, (size_t)n, sizeof *seeds, cmp_int);
+    size_t used = 0;
+    for (int k = 0; k < n; k++) {
+        if (k > 0 && seeds[k] == seeds[k - 1]) continue;
+        int w = snprintf(b->seeds + used, sizeof b->seeds - used, "%s%d", used ? ", " : "",
+                         seeds[k]);
+        if (w < 0 || (size_t)w >= sizeof b->seeds - used) {
+            memcpy(b->seeds + sizeof b->seeds - sizeof ", …", ", …", sizeof ", …");
+            break;
+        }
+        used += (size_t)w;
+    }
+    free(seeds);
+    return TCB_OK;
+}
+
+/* cells[0 .. n): one (dataset, sequence), sorted by method then seed. */
+static int build_block(const tcb_cell_result *cells, int n, tcb_rpt_block *b, tcb_error *err)
+{
+    memset(b, 0, sizeof *b);
+    snprintf(b->dataset, sizeof b->dataset, "%s", cells[0].dataset);
+    snprintf(b->sequence, sizeof b->sequence, "%s", cells[0].sequence);
+    snprintf(b->role, sizeof b->role, "%s", cells[0].role);
+    for (int k = 1; k < n; k++)
+        if (strcmp(cells[k].role, b->role))
+            return tcb_fail(err, TCB_ERR_INPUT,
+                            "cells of %s/%s disagree on the role: %s (%s) vs %s (%s seed %d)",
+                            b->dataset, b->sequence, b->role, cells[0].method, cells[k].role,
+                            cells[k].method, cells[k].seed);
+    b->rows = calloc((size_t)n, sizeof *b->rows);
+    if (!b->rows) return tcb_fail(err, TCB_ERR_NOMEM, "report: out of memory");
+    for (int k = 0; k < n;) {
+        int e = k + 1;
+        while (e < n && !strcmp(cells[e].method, cells[k].method)) e++;
+        build_row(cells + k, e - k, &b->rows[b->n_rows++]);
+        k = e;
+    }
+    finish_block(b);
+    return block_seeds(cells, n, b, err);
+}
+
+/* ------------------------------------------------------ MEAN of a dataset */
+
+static const tcb_rpt_row *find_row(const tcb_rpt_block *b, const char *method)
+{
+    for (int k = 0; k < b->n_rows; k++)
+        if (!strcmp(b->rows[k].method, method)) return &b->rows[k];
+    return NULL;
+}
+
+/* The mean over the test blocks `tests[0 .. nt)` of one method's per-sequence
+ * means, and separately of its per-sequence stds (§5.6). */
+static void mean_row(const tcb_rpt_block *const *tests, int nt, const char *method,
+                     tcb_rpt_row *r)
+{
+    memset(r, 0, sizeof *r);
+    snprintf(r->method, sizeof r->method, "%s", method);
+    r->status = "ok";
+    int n_bad = 0;
+    for (int t = 0; t < nt; t++) {
+        const tcb_rpt_row *s = find_row(tests[t], method);
+        const char *st = s ? s->status : "missing";
+        if (strcmp(st, "ok") && n_bad++ == 0) {
+            r->status = st;
+            snprintf(r->message, sizeof r->message, "%.127s: %.880s", tests[t]->sequence,
+                     s ? s->message : "no cell");
+        }
+    }
+    if (n_bad) {
+        snprintf(r->status_text, sizeof r->status_text, "%s (%d/%d test sequences)", r->status,
+                 n_bad, nt);
+        return;
+    }
+    snprintf(r->status_text, sizeof r->status_text, "ok");
+    for (int m = 0; m < TCB_N_METRICS; m++) r->has[m] = 1;
+    for (int t = 0; t < nt; t++) {
+        const tcb_rpt_row *s = find_row(tests[t], method);
+        if (s->n_seeds > r->n_seeds) r->n_seeds = s->n_seeds;
+        r->n_pairs += s->n_pairs;
+        for (int m = 0; m < TCB_N_METRICS; m++) {
+            r->has[m] &= s->has[m];
+            r->mean[m] += s->mean[m] / nt;
+            r->std[m] += s->std[m] / nt;
+        }
+        r->sl2sq_mean += s->sl2sq_mean / nt;
+        r->sl2sq_std += s->sl2sq_std / nt;
+        for (int k = 0; k < TCB_PCK_STEPS; k++) r->pck[k] += s->pck[k] / nt;
+    }
+}
+
+static int cmp_row(const void *a, const void *b)
+{
+    return strcmp(((const tcb_rpt_row *)a)->method, ((const tcb_rpt_row *)b)->method);
+}
+
+static int build_mean(tcb_rpt *r, tcb_rpt_dataset *d, tcb_error *err)
+{
+    const tcb_rpt_block **tests = malloc((size_t)d->n * sizeof *tests);
+    if (!tests) return tcb_fail(err, TCB_ERR_NOMEM, "report: out of memory");
+    int nt = 0, max_rows = 0;
+    size_t used = 0;
+    for (int k = d->first; k < d->first + d->n; k++) {
+        const tcb_rpt_block *b = &r->blocks[k];
+        if (strcmp(b->role, "test")) continue;
+        tests[nt++] = b;
+        max_rows += b->n_rows;
+        int w = snprintf(d->test_sequences + used, sizeof d->test_sequences - used, "%s%s",
+                         used ? ", " : "", b->sequence);
+        if (w > 0 && (size_t)w < sizeof d->test_sequences - used) used += (size_t)w;
+    }
+    d->n_test = nt;
+    if (!nt) {
+        free(tests);
+        return TCB_OK;
+    }
+    tcb_rpt_block *m = &d->mean;
+    snprintf(m->dataset, sizeof m->dataset, "%s", d->name);
+    snprintf(m->sequence, sizeof m->sequence, "MEAN");
+    snprintf(m->role, sizeof m->role, "mean");
+    m->rows = calloc((size_t)max_rows, sizeof *m->rows);
+    if (!m->rows) {
+        free(tests);
+        return tcb_fail(err, TCB_ERR_NOMEM, "report: out of memory");
+    }
+    /* Methods: the union over test sequences; one absent somewhere is "missing". */
+    for (int t = 0; t < nt; t++)
+        for (int k = 0; k < tests[t]->n_rows; k++) {
+            const char *name = tests[t]->rows[k].method;
+            if (!find_row(m, name))
+                mean_row(tests, nt, name, &m->rows[m->n_rows++]);
+        }
+    qsort(m->rows, (size_t)m->n_rows, sizeof *m->rows, cmp_row);
+    snprintf(m->seeds, sizeof m->seeds, "%s", tests[0]->seeds);
+    finish_block(m);
+    free(tests);
+    return TCB_OK;
+}
+
+/* --------------------------------------------------------------- the run */
+
+static int build_datasets(tcb_rpt *r, tcb_error *err)
+{
+    r->datasets = calloc((size_t)r->n_blocks, sizeof *r->datasets);
+    if (!r->datasets) return tcb_fail(err, TCB_ERR_NOMEM, "report: out of memory");
+    for (int k = 0; k < r->n_blocks;) {
+        tcb_rpt_dataset *d = &r->datasets[r->n_datasets++];
+        snprintf(d->name, sizeof d->name, "%s", r->blocks[k].dataset);
+        d->first = k;
+        while (k < r->n_blocks && !strcmp(r->blocks[k].dataset, d->name)) k++;
+        d->n = k - d->first;
+        int rc = build_mean(r, d, err);
+        if (rc) return rc;
+    }
+    return TCB_OK;
+}
+
+int tcb_rpt_build(const tcb_cell_result *cells, int n, tcb_rpt *out, tcb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (n <= 0) return TCB_OK;
+    out->blocks = calloc((size_t)n, sizeof *out->blocks);
+    if (!out->blocks) return tcb_fail(err, TCB_ERR_NOMEM, "report: out of memory");
+    int rc = TCB_OK;
+    for (int k = 0; k < n && !rc;) {
+        int e = k + 1;
+        while (e < n && same_block(&cells[k], &cells[e])) e++;
+        rc = build_block(cells + k, e - k, &out->blocks[out->n_blocks++], err);
+        k = e;
+    }
+    if (!rc) rc = build_datasets(out, err);
+    if (rc) tcb_rpt_free(out);
+    return rc;
+}
+
+int tcb_rpt_load(const char *run_dir, tcb_rpt *out, tcb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    tcb_cell_result *cells;
+    int n;
+    int rc = tcb_results_scan(run_dir, &cells, &n, err);
+    if (rc) return rc;
+    if (n == 0)
+        rc = tcb_fail(err, TCB_ERR_INPUT, "%s/cells: no cell files: nothing to report", run_dir);
+    else
+        rc = tcb_rpt_build(cells, n, out, err);
+    for (int k = 0; k < n; k++) tcb_cell_free(&cells[k]);
+    free(cells);
+    return rc;
+}
+
+void tcb_rpt_free(tcb_rpt *r)
+{
+    for (int k = 0; k < r->n_blocks; k++) free(r->blocks[k].rows);
+    for (int k = 0; k < r->n_datasets; k++) free(r->datasets[k].mean.rows);
+    free(r->blocks);
+    free(r->datasets);
+    memset(r, 0, sizeof *r);
+}
+
+void tcb_rpt_cell_text(const tcb_rpt_row *r, int metric, const char *pm, char *out, size_t size)
+{
+    const tcb_rpt_metric_def *d = &tcb_rpt_metrics[metric];
+    if (strcmp(r->status, "ok"))
+        snprintf(out, size, "%s", r->status);
+    else if (!r->has[metric])
+        snprintf(out, size, "-");
+    else
+        snprintf(out, size, "%.*f%s%.*f", d->decimals, r->mean[metric], pm, d->decimals,
+                 r->std[metric]);
+}

@@ -1,0 +1,88 @@
+/* Private to reports/: a run's cells folded into the table model that every
+ * writer renders (Markdown, LaTeX, CSV, PCK plots, baseline, check).
+ *
+ * One block per (dataset, sequence), one row per method, seeds pooled with
+ * tcb_summary_merge. Values are in table units (m_sL2 ×1e3, rank %, AUC %,
+ * CD ×1e3). A row shows numbers only when every pooled cell is "ok";
+ * otherwise it carries the status, so a failure never hides behind a number. */
+#ifndef TCB_REPORTS_AGGREGATE_H
+#define TCB_REPORTS_AGGREGATE_H
+
+#include <stddef.h>
+
+#include "tcb/error.h"
+#include "tcb/metrics.h"
+#include "tcb/results.h"
+
+typedef enum tcb_rpt_metric {
+    TCB_M_SL2,
+    TCB_M_RANK,
+    TCB_M_AUC,
+    TCB_M_CD,
+    TCB_N_METRICS
+} tcb_rpt_metric;
+
+typedef struct tcb_rpt_metric_def {
+    const char *key;       /* "sl2": baseline keys, CSV column stems */
+    const char *label;     /* "m_sL2 ↓": Markdown header */
+    const char *tex_label; /* LaTeX header */
+    double scale;          /* raw value × scale = table units */
+    int decimals;          /* printf precision in table units */
+    int lower_is_better;
+} tcb_rpt_metric_def;
+
+extern const tcb_rpt_metric_def tcb_rpt_metrics[TCB_N_METRICS];
+
+typedef struct tcb_rpt_row {
+    char method[64];
+    const char *status;               /* "ok", "failed", "diverged" or "missing" */
+    char status_text[64];             /* status plus how many pooled parts had it */
+    char message[TCB_ERRMSG_MAX];     /* first failing cell: "seed 1: …" */
+    int n_seeds;                      /* cells pooled (MEAN rows: the most of any sequence) */
+    int n_pairs;                      /* pairs per cell (MEAN rows: sum over sequences) */
+    int has[TCB_N_METRICS];           /* 0 → "-" (no reconstruction, or not ok) */
+    int best[TCB_N_METRICS];          /* best of its block as displayed */
+    double mean[TCB_N_METRICS];       /* table units */
+    double std[TCB_N_METRICS];        /* table units */
+    double sl2sq_mean, sl2sq_std;     /* ×1e3; valid when has[TCB_M_SL2] */
+    double pck[TCB_PCK_STEPS];        /* percent; valid when status is "ok" */
+} tcb_rpt_row;
+
+typedef struct tcb_rpt_block {
+    char dataset[64];
+    char sequence[128];               /* "MEAN" for a dataset mean block */
+    char role[16];                    /* "train" | "validation" | "test" | "mean" */
+    char seeds[128];                  /* distinct seeds, "0, 1" */
+    int n_pairs_min, n_pairs_max;     /* over the block's rows */
+    int n_rows;
+    tcb_rpt_row *rows;                /* [n_rows], sorted by method */
+} tcb_rpt_block;
+
+typedef struct tcb_rpt_dataset {
+    char name[64];
+    int first, n;                     /* its blocks: blocks[first .. first + n) */
+    int n_test;                       /* test sequences; 0 → no MEAN block */
+    char test_sequences[512];         /* "horse, camel" */
+    tcb_rpt_block mean;               /* valid when n_test > 0 */
+} tcb_rpt_dataset;
+
+typedef struct tcb_rpt {
+    int n_blocks;
+    tcb_rpt_block *blocks;            /* sorted by dataset, sequence */
+    int n_datasets;
+    tcb_rpt_dataset *datasets;
+} tcb_rpt;
+
+/* cells sorted as tcb_results_scan returns them. */
+int tcb_rpt_build(const tcb_cell_result *cells, int n, tcb_rpt *out, tcb_error *err);
+/* Scan <run>/cells and build; a run without cells is an error. */
+int tcb_rpt_load(const char *run_dir, tcb_rpt *out, tcb_error *err);
+void tcb_rpt_free(tcb_rpt *r);
+
+/* One table cell: "mean<pm>std" in the metric's precision, "-" when the row
+ * has no value, or the row's status when it is not ok (the tables explain
+ * it below with status_text and message). */
+void tcb_rpt_cell_text(const tcb_rpt_row *r, int metric, const char *pm, char *out,
+                       size_t size);
+
+#endif

@@ -1,0 +1,36 @@
+/* Private to reports/: the regression baseline "tcbench-baseline/1".
+ *
+ *   { "format": "tcbench-baseline/1",
+ *     "tolerances": { "sl2": {"abs", "rel"}, "rank": …, "auc": …, "cd": … },
+ *     "rows": [ { "dataset", "sequence", "method",
+ *                 "sl2", "rank", "auc", "cd",        table units; null = none
+ *                 "status" } ] }                     optional, "ok" by default
+ * A value passes when |current − baseline| ≤ abs + rel·|baseline|. Rows of
+ * failed or diverged methods carry their status and null values. */
+#ifndef TCB_REPORTS_BASELINE_H
+#define TCB_REPORTS_BASELINE_H
+
+#include "reports/aggregate.h"
+
+#define TCB_BASELINE_FORMAT "tcbench-baseline/1"
+
+typedef struct tcb_baseline_row {
+    char dataset[64];
+    char sequence[128];
+    char method[64];
+    char status[16];             /* "ok" | "failed" | "diverged" */
+    int has[TCB_N_METRICS];      /* 0: null */
+    double value[TCB_N_METRICS]; /* table units */
+} tcb_baseline_row;
+
+typedef struct tcb_baseline {
+    double abs_tol[TCB_N_METRICS];
+    double rel_tol[TCB_N_METRICS];
+    int n_rows;
+    tcb_baseline_row *rows;
+} tcb_baseline;
+
+int tcb_baseline_load(const char *path, tcb_baseline *out, tcb_error *err);
+void tcb_baseline_free(tcb_baseline *b);
+
+#endif

@@ -1,0 +1,60 @@
+/* results.csv: one row per (dataset, sequence, method), then each dataset's
+ * MEAN rows (sequence "MEAN", role "mean"). Table units, the tables'
+ * precision; empty fields where the tables show "-" or a status. */
+#include <string.h>
+
+#include "reports/writers.h"
+
+static void put_field(FILE *f, const char *s)
+{
+    if (!strpbrk(s, ",\"\n")) {
+        fputs(s, f);
+        return;
+    }
+    fputc('"', f);
+    for (; *s; s++) {
+        if (*s == '"') fputc('"', f);
+        fputc(*s, f);
+    }
+    fputc('"', f);
+}
+
+static void put_num(FILE *f, int has, double x, int decimals)
+{
+    if (has) fprintf(f, ",%.*f", decimals, x);
+    else fputc(',', f);
+}
+
+static void write_row(FILE *f, const tcb_rpt_block *b, const tcb_rpt_row *r)
+{
+    put_field(f, b->dataset);
+    fputc(',', f);
+    put_field(f, b->sequence);
+    fprintf(f, ",%s,", b->role);
+    put_field(f, r->method);
+    fprintf(f, ",%s,%d,%d", r->status, r->n_seeds, r->n_pairs);
+    for (int m = 0; m < TCB_N_METRICS; m++) {
+        put_num(f, r->has[m], r->mean[m], tcb_rpt_metrics[m].decimals);
+        put_num(f, r->has[m], r->std[m], tcb_rpt_metrics[m].decimals);
+    }
+    /* sL2² is a squared distance like CD: same precision. */
+    put_num(f, r->has[TCB_M_SL2], r->sl2sq_mean, tcb_rpt_metrics[TCB_M_CD].decimals);
+    put_num(f, r->has[TCB_M_SL2], r->sl2sq_std, tcb_rpt_metrics[TCB_M_CD].decimals);
+    fputc('\n', f);
+}
+
+void tcb_rpt_write_csv(FILE *f, const tcb_rpt *r)
+{
+    fputs("dataset,sequence,role,method,status,seeds,n_pairs,sl2_x1e3_mean,sl2_x1e3_std,"
+          "rank_pct_mean,rank_pct_std,auc_pct_mean,auc_pct_std,cd_x1e3_mean,cd_x1e3_std,"
+          "sl2sq_x1e3_mean,sl2sq_x1e3_std\n",
+          f);
+    for (int d = 0; d < r->n_datasets; d++) {
+        const tcb_rpt_dataset *ds = &r->datasets[d];
+        for (int k = ds->first; k < ds->first + ds->n; k++)
+            for (int i = 0; i < r->blocks[k].n_rows; i++)
+                write_row(f, &r->blocks[k], &r->blocks[k].rows[i]);
+        for (int i = 0; ds->n_test && i < ds->mean.n_rows; i++)
+            write_row(f, &ds->mean, &ds->mean.rows[i]);
+    }
+}

@@ -1,0 +1,73 @@
+/* LaTeX tables (booktabs): one table per dataset, a block per sequence,
+ * then the MEAN block over the test sequences. */
+#include <string.h>
+
+#include "reports/writers.h"
+
+/* Names come from configs; escape what LaTeX would read as markup. */
+static void put_escaped(FILE *f, const char *s)
+{
+    for (; *s; s++) {
+        switch (*s) {
+        case '_': case '&': case '%': case '$': case '#': case '{': case '}':
+            fprintf(f, "\\%c", *s);
+            break;
+        case '~': fputs("\\textasciitilde{}", f); break;
+        case '^': fputs("\\textasciicircum{}", f); break;
+        case '\\': fputs("\\textbackslash{}", f); break;
+        default: fputc(*s, f);
+        }
+    }
+}
+
+static void write_block(FILE *f, const tcb_rpt_block *b, const char *title)
+{
+    for (int k = 0; k < b->n_rows; k++) {
+        const tcb_rpt_row *r = &b->rows[k];
+        if (k == 0) put_escaped(f, title);
+        fputs(" & ", f);
+        put_escaped(f, r->method);
+        for (int m = 0; m < TCB_N_METRICS; m++) {
+            char cell[128];
+            tcb_rpt_cell_text(r, m, " $\\pm$ ", cell, sizeof cell);
+            if (r->best[m])
+                fprintf(f, " & \\textbf{%s}", cell);
+            else if (strcmp(r->status, "ok"))
+                fprintf(f, " & \\textit{%s}", cell);
+            else
+                fprintf(f, " & %s", cell);
+        }
+        fputs(" \\\\\n", f);
+    }
+}
+
+static void write_dataset(FILE *f, const tcb_rpt *r, const tcb_rpt_dataset *d)
+{
+    fputs("\\begin{table}[t]\n\\centering\n\\caption{", f);
+    put_escaped(f, d->name);
+    fputs(": m\\_sL2 $\\times 10^{3}$, rank \\%, AUC \\%, CD $\\times 10^{3}$ (mean $\\pm$ std); "
+          "best in bold, ``-'': no reconstruction. MEAN: over the test sequences.}\n"
+          "\\begin{tabular}{llcccc}\n\\toprule\nSequence & Method",
+          f);
+    for (int m = 0; m < TCB_N_METRICS; m++) fprintf(f, " & %s", tcb_rpt_metrics[m].tex_label);
+    fputs(" \\\\\n", f);
+    for (int k = d->first; k < d->first + d->n; k++) {
+        const tcb_rpt_block *b = &r->blocks[k];
+        char title[160];
+        snprintf(title, sizeof title, "%s (%s)", b->sequence, b->role);
+        fputs("\\midrule\n", f);
+        write_block(f, b, title);
+    }
+    fputs("\\midrule\n", f);
+    if (d->n_test)
+        write_block(f, &d->mean, "MEAN");
+    else
+        fputs("\\multicolumn{6}{l}{\\textit{no test sequence: no MEAN}} \\\\\n", f);
+    fputs("\\bottomrule\n\\end{tabular}\n\\end{table}\n\n", f);
+}
+
+void tcb_rpt_write_tex(FILE *f, const tcb_rpt *r)
+{
+    fputs("% tcbench results; needs \\usepackage{booktabs}.\n\n", f);
+    for (int k = 0; k < r->n_datasets; k++) write_dataset(f, r, &r->datasets[k]);
+}

@@ -1,0 +1,104 @@
+#!/usr/bin/env bash
+# Resume: a run killed (SIGKILL) midway and rerun yields cell files identical
+# to an uninterrupted run (timings and peak RSS aside) and leaves no
+# temporaries; a finished run reruns as all skips; a checkpoint (good or
+# corrupt) gives the same cell as a fit; changed settings refuse to resume.
+set -euo pipefail
+: "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
+source "$TCB_SOURCE_DIR/tests/integration/harness_methods.sh"
+
+tmp=$(mktemp -d)
+pid=""
+trap '[ -n "$pid" ] && kill -9 "$pid" 2>/dev/null; rm -rf "$tmp"' EXIT
+cd "$tmp"
+build_harness_methods "$tmp/libharness_methods.so"
+
+cat > grid.json <<JSON
+{ "name": "grid", "splits_dir": "splits", "cache_dir": "", "seeds": [0, 1],
+  "plugins": ["$tmp/libharness_methods.so"],
+  "evaluation": { "pairs": 10, "pool_size": 1000 },
+  "datasets": [ { "name": "synth", "source": "synthetic", "frames": 12,
+                  "sequences": [ { "name": "quadruped_walk", "role": "validation" },
+                                 { "name": "quadruped_trot", "role": "test" } ] } ],
+  "methods": [ { "name": "oracle" }, { "name": "nearest" },
+               { "name": "slow", "method": "slow_noisy", "params": { "delay_ms": 40, "noise": 0.01 } } ] }
+JSON
+n_cells=12
+count_cells() { find "$1/cells" -name 'seed_*.json' 2>/dev/null | wc -l; }
+
+# same_cells A B: the same cell files with the same contents, but for the
+# fields that measure the machine rather than the method.
+same_cells() {
+    /usr/bin/python3 - "$1" "$2" <<'PY'
+import json, os, sys
+def cells(root):
+    out = {}
+    for d, _, files in os.walk(os.path.join(root, "cells")):
+        for f in files:
+            c = json.load(open(os.path.join(d, f)))
+            c.pop("timings"); c.pop("peak_rss_kb")
+            out[os.path.relpath(os.path.join(d, f), root)] = c
+    return out
+a, b = cells(sys.argv[1]), cells(sys.argv[2])
+assert sorted(a) == sorted(b), (sorted(a), sorted(b))
+for k in a:
+    assert a[k] == b[k], "cell %s differs" % k
+print("%d cells identical" % len(a))
+PY
+}
+
+"$TCBENCH" run grid.json --out full --quiet
+[ "$(count_cells full)" -eq $n_cells ] || { echo "FAIL: uninterrupted run incomplete"; exit 1; }
+
+# Kill a second run once a few cells are done, then resume it.
+"$TCBENCH" run grid.json --out killed --quiet 2> killed.log &
+pid=$!
+for _ in $(seq 600); do
+    [ "$(count_cells killed)" -ge 3 ] && break
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.05
+done
+kill -9 "$pid" 2>/dev/null || true
+wait "$pid" 2>/dev/null || true
+pid=""
+done_at_kill=$(count_cells killed)
+if [ "$done_at_kill" -lt 3 ] || [ "$done_at_kill" -ge $n_cells ]; then
+    echo "FAIL: killed with $done_at_kill of $n_cells cells done (expected a partial run)"
+    cat killed.log; exit 1
+fi
+# What a kill during an atomic write leaves behind, on a cell still to do.
+mkdir -p killed/cells/synth/quadruped_trot/slow
+touch killed/cells/synth/quadruped_trot/slow/seed_1.json.tmp-Ab12Cd killed/config.json.tmp-Xy34Zw
+"$TCBENCH" run grid.json --out killed --quiet 2> resume.log
+grep -qF "$((n_cells - done_at_kill)) computed, $done_at_kill already done" resume.log ||
+    { cat resume.log; exit 1; }
+same_cells full killed
+leftovers=$(find killed splits -name '*.tmp-*')
+[ -z "$leftovers" ] || { echo "FAIL: temporaries left: $leftovers"; exit 1; }
+
+# A finished run skips every cell.
+"$TCBENCH" run grid.json --out killed --quiet 2> rerun.log
+grep -qF "0 computed, $n_cells already done" rerun.log || { cat rerun.log; exit 1; }
+
+# Evaluation resumed from a checkpoint (then from a corrupt one) matches.
+cell=killed/cells/synth/quadruped_trot/slow/seed_1.json
+ckpt=killed/work/synth/quadruped_trot/slow/seed_1/model.ckpt
+[ -s "$ckpt" ] || { echo "FAIL: no checkpoint at $ckpt"; exit 1; }
+rm "$cell"
+"$TCBENCH" run grid.json --out killed --quiet 2> ckpt.log
+grep -qF "1 computed" ckpt.log || { cat ckpt.log; exit 1; }
+same_cells full killed
+echo "garbage" > "$ckpt"
+rm "$cell"
+"$TCBENCH" run grid.json --out killed 2> corrupt.log
+grep -qF "not reused" corrupt.log || { echo "FAIL: corrupt checkpoint not reported"; cat corrupt.log; exit 1; }
+same_cells full killed
+
+# Cells made with other settings are not silently mixed in.
+sed 's/"noise": 0.01/"noise": 0.02/' grid.json > changed.json
+rc=0
+"$TCBENCH" run changed.json --out killed --quiet 2> changed.log || rc=$?
+[ "$rc" -eq 2 ] && grep -qF "was computed with another params" changed.log ||
+    { echo "FAIL: changed params resumed (exit $rc)"; cat changed.log; exit 1; }
+"$TCBENCH" run changed.json --out killed --quiet --only slow --force
+echo "resume test passed"

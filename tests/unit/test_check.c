@@ -1,0 +1,280 @@
+/* Regression check: a baseline written from a run checks clean; values
+ * moved beyond their tolerance, changed statuses and missing or extra rows
+ * drift; malformed baselines are input errors naming the file. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "fake_run.h"
+#include "tcb/json.h"
+#include "tcb/report.h"
+#include "testutil.h"
+
+typedef struct fixture {
+    char dir[512];
+    char baseline[1024];
+} fixture;
+
+static const fake_cell CELLS[] = {
+    {"anim", "cat", "validation", "AN", 0, TCB_CELL_OK, 0.03, 1},
+    {"anim", "horse", "test", "AN", 0, TCB_CELL_OK, 0.01, 1},
+    {"anim", "horse", "test", "AN", 1, TCB_CELL_OK, 0.01, 1},
+    {"anim", "horse", "test", "NN", 0, TCB_CELL_OK, 0.02, 0},
+    {"anim", "horse", "test", "DSR", 0, TCB_CELL_DIVERGED, 0.01, 1},
+};
+#define N_CELLS ((int)(sizeof CELLS / sizeof CELLS[0]))
+
+static int setup(void **state)
+{
+    fixture *f = calloc(1, sizeof *f);
+    tu_make_tmpdir(f->dir, sizeof f->dir);
+    for (int k = 0; k < N_CELLS; k++)
+        if (fake_write(f->dir, &CELLS[k])) return -1;
+    snprintf(f->baseline, sizeof f->baseline, "%s/baseline.json", f->dir);
+    tcb_error err = {0};
+    if (tcb_baseline_write(f->dir, f->baseline, &err)) {
+        fprintf(stderr, "%s\n", err.msg);
+        return -1;
+    }
+    *state = f;
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    fixture *f = *state;
+    tu_remove_tree(f->dir);
+    free(f);
+    return 0;
+}
+
+/* Runs the check; returns the drift count, the diff table in *table. */
+static int check(const fixture *f, const char *baseline, char **table)
+{
+    size_t len;
+    FILE *out = open_memstream(table, &len);
+    assert_non_null(out);
+    int n_drift = -1;
+    tcb_error err = {0};
+    int rc = tcb_check(f->dir, baseline, out, &n_drift, &err);
+    fclose(out);
+    if (rc) fail_msg("tcb_check: %s", err.msg);
+    return n_drift;
+}
+
+/* The baseline with the row (sequence, method) edited by `edit`, saved next
+ * to the original as `name`. */
+typedef void (*row_edit)(cJSON *root, cJSON *row);
+
+static void edited(const fixture *f, const char *sequence, const char *method, row_edit edit,
+                   const char *name, char *out, size_t size)
+{
+    cJSON *root;
+    tcb_error err = {0};
+    assert_int_equal(tcb_json_load(f->baseline, &root, &err), TCB_OK);
+    cJSON *row = NULL;
+    for (cJSON *r = cJSON_GetObjectItem(root, "rows")->child; r; r = r->next)
+        if (!strcmp(cJSON_GetObjectItem(r, "sequence")->valuestring, sequence) &&
+            !strcmp(cJSON_GetObjectItem(r, "method")->valuestring, method))
+            row = r;
+    assert_non_null(row);
+    edit(root, row);
+    snprintf(out, size, "%s/%s", f->dir, name);
+    assert_int_equal(tcb_json_save(out, root, &err), TCB_OK);
+    cJSON_Delete(root);
+}
+
+/* The lines of `table` that end in DRIFT. */
+static int drift_lines(const char *table, char lines[][256], int max)
+{
+    int n = 0;
+    for (const char *p = table; *p && n < max;) {
+        const char *end = strchr(p, '\n');
+        size_t len = end ? (size_t)(end - p) : strlen(p);
+        if (len >= 5 && !strncmp(p + len - 5, "DRIFT", 5))
+            snprintf(lines[n++], 256, "%.*s", (int)len, p);
+        p += len + (end != NULL);
+    }
+    return n;
+}
+
+static void test_baseline_checks_clean(void **state)
+{
+    fixture *f = *state;
+    char *table;
+    assert_int_equal(check(f, f->baseline, &table), 0);
+    assert_null(strstr(table, "DRIFT"));
+    assert_non_null(strstr(table, "anim/horse/DSR"));
+    assert_non_null(strstr(table, "0 drift"));
+    free(table);
+}
+
+static void shift(cJSON *row, double by)
+{
+    cJSON *v = cJSON_GetObjectItem(row, "sl2");
+    cJSON_SetNumberValue(v, v->valuedouble + by);
+}
+static void beyond_tolerance(cJSON *root, cJSON *row) { (void)root, shift(row, 1e-3); }
+static void within_tolerance(cJSON *root, cJSON *row) { (void)root, shift(row, 5e-7); }
+
+static void test_drift_beyond_tolerance(void **state)
+{
+    fixture *f = *state;
+    char path[2048], *table, lines[8][256];
+    edited(f, "horse", "AN", beyond_tolerance, "beyond.json", path, sizeof path);
+    assert_int_equal(check(f, path, &table), 1);
+    assert_int_equal(drift_lines(table, lines, 8), 1);
+    assert_non_null(strstr(lines[0], "anim/horse/AN "));
+    assert_non_null(strstr(lines[0], " sl2 "));
+    assert_non_null(strstr(lines[0], "-1.000e-03"));
+    free(table);
+    edited(f, "horse", "AN", within_tolerance, "within.json", path, sizeof path);
+    assert_int_equal(check(f, path, &table), 0);
+    free(table);
+}
+
+/* rel = 1e-3 lets sl2 move by 0.1 %: 0.05 % passes, 0.2 % drifts. */
+static void loosen(cJSON *root, cJSON *row, double fraction)
+{
+    cJSON *t = cJSON_GetObjectItem(cJSON_GetObjectItem(root, "tolerances"), "sl2");
+    cJSON_SetNumberValue(cJSON_GetObjectItem(t, "abs"), 0);
+    cJSON_SetNumberValue(cJSON_GetObjectItem(t, "rel"), 1e-3);
+    shift(row, fraction * cJSON_GetObjectItem(row, "sl2")->valuedouble);
+}
+static void loosen_small(cJSON *root, cJSON *row) { loosen(root, row, 5e-4); }
+static void loosen_large(cJSON *root, cJSON *row) { loosen(root, row, 2e-3); }
+
+static void test_relative_tolerance(void **state)
+{
+    fixture *f = *state;
+    char path[2048], *table;
+    edited(f, "cat", "AN", loosen_small, "rel_small.json", path, sizeof path);
+    assert_int_equal(check(f, path, &table), 0);
+    free(table);
+    edited(f, "cat", "AN", loosen_large, "rel_large.json", path, sizeof path);
+    assert_int_equal(check(f, path, &table), 1);
+    free(table);
+}
+
+static void cd_appears(cJSON *root, cJSON *row)
+{
+    (void)root;
+    cJSON_ReplaceItemInObject(row, "cd", cJSON_CreateNumber(0.1));
+}
+static void status_changes(cJSON *root, cJSON *row)
+{
+    (void)root;
+    cJSON_ReplaceItemInObject(row, "status", cJSON_CreateString("failed"));
+}
+
+static void test_null_and_status_mismatch_drift(void **state)
+{
+    fixture *f = *state;
+    char path[2048], *table, lines[8][256];
+    edited(f, "horse", "NN", cd_appears, "cd.json", path, sizeof path);
+    assert_int_equal(check(f, path, &table), 1);
+    assert_int_equal(drift_lines(table, lines, 8), 1);
+    assert_non_null(strstr(lines[0], "anim/horse/NN "));
+    assert_non_null(strstr(lines[0], " cd "));
+    free(table);
+    edited(f, "horse", "DSR", status_changes, "status.json", path, sizeof path);
+    assert_int_equal(check(f, path, &table), 1);
+    assert_int_equal(drift_lines(table, lines, 8), 1);
+    assert_non_null(strstr(lines[0], "failed"));
+    assert_non_null(strstr(lines[0], "diverged"));
+    free(table);
+}
+
+static void drop_row(cJSON *root, cJSON *row)
+{
+    cJSON_Delete(cJSON_DetachItemViaPointer(cJSON_GetObjectItem(root, "rows"), row));
+}
+
+static void test_missing_and_extra_rows_drift(void **state)
+{
+    fixture *f = *state;
+    char path[2048], *table, lines[8][256];
+    /* The run has a row the baseline lacks. */
+    edited(f, "horse", "NN", drop_row, "dropped.json", path, sizeof path);
+    assert_int_equal(check(f, path, &table), 1);
+    assert_int_equal(drift_lines(table, lines, 8), 1);
+    assert_non_null(strstr(lines[0], "anim/horse/NN "));
+    assert_non_null(strstr(lines[0], "present"));
+    free(table);
+    /* The baseline has a row the run lacks. */
+    char cell[2048];
+    tcb_error err = {0};
+    assert_int_equal(tcb_cell_path(cell, sizeof cell, f->dir, "anim", "cat", "AN", 0, &err), 0);
+    assert_int_equal(unlink(cell), 0);
+    assert_int_equal(check(f, f->baseline, &table), 1);
+    assert_int_equal(drift_lines(table, lines, 8), 1);
+    assert_non_null(strstr(lines[0], "anim/cat/AN "));
+    assert_non_null(strstr(lines[0], "missing"));
+    free(table);
+    assert_int_equal(fake_write(f->dir, &CELLS[0]), 0);
+}
+
+static void expect_malformed(const fixture *f, const char *text, const char *key)
+{
+    char path[2048];
+    tu_write_text(f->dir, "bad.json", text, path, sizeof path);
+    int n_drift = -1;
+    tcb_error err = {0};
+    assert_int_equal(tcb_check(f->dir, path, NULL, &n_drift, &err), TCB_ERR_INPUT);
+    if (!strstr(err.msg, path) || !strstr(err.msg, key))
+        fail_msg("message \"%s\" does not name %s and %s", err.msg, path, key);
+}
+
+#define TOL "{\"abs\": 0, \"rel\": 0}"
+#define TOLS                                                                                       \
+    "\"tolerances\": {\"sl2\": " TOL ", \"rank\": " TOL ", \"auc\": " TOL ", \"cd\": " TOL "}"
+#define ROW(m) "{\"dataset\": \"anim\", \"sequence\": \"cat\", \"method\": \"" m "\", " \
+               "\"sl2\": 1, \"rank\": 1, \"auc\": 1, \"cd\": null}"
+
+static void test_malformed_baselines(void **state)
+{
+    fixture *f = *state;
+    expect_malformed(f, "{\"format\": ", ":1:");
+    expect_malformed(f, "{\"format\": \"tcbench-baseline/0\", " TOLS ", \"rows\": []}", "format");
+    expect_malformed(f, "{\"format\": \"tcbench-baseline/1\", " TOLS ", \"rows\": [], \"x\": 1}",
+                     ": x:");
+    expect_malformed(f,
+                     "{\"format\": \"tcbench-baseline/1\", \"tolerances\": {\"sl2\": " TOL
+                     ", \"rank\": " TOL ", \"auc\": " TOL "}, \"rows\": []}",
+                     "tolerances.cd");
+    expect_malformed(f,
+                     "{\"format\": \"tcbench-baseline/1\", \"tolerances\": {\"sl2\": {\"abs\": -1, "
+                     "\"rel\": 0}, \"rank\": " TOL ", \"auc\": " TOL ", \"cd\": " TOL
+                     "}, \"rows\": []}",
+                     "tolerances.sl2.abs");
+    expect_malformed(f,
+                     "{\"format\": \"tcbench-baseline/1\", " TOLS
+                     ", \"rows\": [{\"dataset\": \"anim\", "
+                     "\"sequence\": \"cat\", \"method\": \"AN\", \"sl2\": \"1\", \"rank\": 1, "
+                     "\"auc\": 1, \"cd\": null}]}",
+                     "rows[0].sl2");
+    expect_malformed(f,
+                     "{\"format\": \"tcbench-baseline/1\", " TOLS
+                     ", \"rows\": [" ROW("AN") ", " ROW("AN") "]}",
+                     "rows[1]");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_baseline_checks_clean),
+        cmocka_unit_test(test_drift_beyond_tolerance),
+        cmocka_unit_test(test_relative_tolerance),
+        cmocka_unit_test(test_null_and_status_mismatch_drift),
+        cmocka_unit_test(test_missing_and_extra_rows_drift),
+        cmocka_unit_test(test_malformed_baselines),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}

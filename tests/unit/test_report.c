@@ -1,0 +1,407 @@
+/* Reports from a fake run: two datasets; anim has a validation and two test
+ * sequences, ama only a validation one; methods AN (reconstructs, 2 seeds),
+ * NN (no reconstruction) and DSR (best on horse, failed on camel). Every
+ * expected number is recomputed here from the raw per-vertex errors. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fake_run.h"
+#include "tcb/fsutil.h"
+#include "tcb/report.h"
+#include "testutil.h"
+
+typedef struct seq_spec {
+    const char *dataset, *name, *role;
+    double scale; /* error scale of the sequence: cat is hard */
+} seq_spec;
+
+static const seq_spec SEQS[] = {
+    {"anim", "cat", "validation", 3.0},
+    {"anim", "horse", "test", 1.0},
+    {"anim", "camel", "test", 1.5},
+    {"ama", "crane", "validation", 2.0},
+};
+#define N_SEQS 4
+
+typedef struct method_spec {
+    const char *name;
+    double base;
+    int has_cd, n_seeds;
+} method_spec;
+
+static const method_spec METHODS[] = {
+    {"AN", 0.010, 1, 2}, {"NN", 0.020, 0, 1}, {"DSR", 0.005, 1, 1}};
+#define N_METHODS 3
+
+static fake_cell cell_of(int s, int m, int seed)
+{
+    const seq_spec *q = &SEQS[s];
+    const method_spec *p = &METHODS[m];
+    int failed = !strcmp(p->name, "DSR") && !strcmp(q->name, "camel");
+    return (fake_cell){q->dataset, q->name, q->role, p->name, seed,
+                       failed ? TCB_CELL_FAILED : TCB_CELL_OK, p->base * q->scale, p->has_cd};
+}
+
+/* Expected table values of (sequence, method): [metric] mean and std in
+ * table units, pooled over seeds by hand. */
+typedef struct expect {
+    double mean[4], std[4];
+} expect;
+
+static expect expected(int s, int m)
+{
+    double sl2[8 * FAKE_PAIRS * FAKE_NV], rank[8 * FAKE_PAIRS * FAKE_NV];
+    double auc[8 * FAKE_PAIRS], cd[8 * FAKE_PAIRS];
+    int nv = 0, np = 0;
+    for (int seed = 0; seed < METHODS[m].n_seeds; seed++) {
+        fake_cell c = cell_of(s, m, seed);
+        for (int p = 0; p < FAKE_PAIRS; p++, np++) {
+            tcb_pair_metrics pm;
+            fake_pair(&c, p, &pm);
+            auc[np] = pm.auc;
+            cd[np] = fake_cd(&c, p);
+            for (int k = 0; k < FAKE_NV; k++, nv++) {
+                sl2[nv] = fake_sl2(&c, p, k);
+                rank[nv] = fake_rank(k);
+            }
+        }
+    }
+    expect e;
+    fake_mean_std(sl2, nv, &e.mean[0], &e.std[0]);
+    fake_mean_std(rank, nv, &e.mean[1], &e.std[1]);
+    fake_mean_std(auc, np, &e.mean[2], &e.std[2]);
+    fake_mean_std(cd, np, &e.mean[3], &e.std[3]);
+    static const double scale[4] = {1e3, 1e2, 1e2, 1e3};
+    for (int k = 0; k < 4; k++) e.mean[k] *= scale[k], e.std[k] *= scale[k];
+    return e;
+}
+
+/* The dataset MEAN over the given sequences (§5.6: means and stds averaged
+ * separately). */
+static expect expected_mean(const int *seqs, int n, int m)
+{
+    expect e = {{0}, {0}};
+    for (int k = 0; k < n; k++) {
+        expect s = expected(seqs[k], m);
+        for (int j = 0; j < 4; j++) e.mean[j] += s.mean[j] / n, e.std[j] += s.std[j] / n;
+    }
+    return e;
+}
+
+static const int DECIMALS[4] = {2, 2, 2, 3};
+
+/* "| AN | **1.00 ± 0.20** | … |" with `bold` a 4-bit mask and `no_cd` "-". */
+static void md_row(const char *method, const expect *e, int bold, int no_cd, char *out,
+                   size_t size)
+{
+    size_t used = (size_t)snprintf(out, size, "| %s |", method);
+    for (int j = 0; j < 4; j++) {
+        const char *b = bold >> j & 1 ? "**" : "";
+        if (j == 3 && no_cd)
+            used += (size_t)snprintf(out + used, size - used, " - |");
+        else
+            used += (size_t)snprintf(out + used, size - used, " %s%.*f ± %.*f%s |", b, DECIMALS[j],
+                                     e->mean[j], DECIMALS[j], e->std[j], b);
+    }
+}
+
+static char *read_all(const char *path)
+{
+    char *text;
+    tcb_error err = {0};
+    if (tcb_read_file(path, &text, NULL, &err)) fail_msg("%s", err.msg);
+    return text;
+}
+
+typedef struct fixture {
+    char dir[512];
+    char report[1024];
+    char *md;
+} fixture;
+
+static int setup(void **state)
+{
+    fixture *f = calloc(1, sizeof *f);
+    tu_make_tmpdir(f->dir, sizeof f->dir);
+    for (int s = 0; s < N_SEQS; s++)
+        for (int m = 0; m < N_METHODS; m++)
+            for (int seed = 0; seed < METHODS[m].n_seeds; seed++) {
+                fake_cell c = cell_of(s, m, seed);
+                if (fake_write(f->dir, &c)) return -1;
+            }
+    snprintf(f->report, sizeof f->report, "%s/report", f->dir);
+    char echo_path[4096];
+    snprintf(echo_path, sizeof echo_path, "%s/echo.md", f->dir);
+    FILE *echo = fopen(echo_path, "w");
+    tcb_error err = {0};
+    int rc = tcb_report_write(f->dir, NULL, echo, &err);
+    fclose(echo);
+    if (rc) {
+        fprintf(stderr, "tcb_report_write: %s\n", err.msg);
+        return -1;
+    }
+    char md_path[4096];
+    snprintf(md_path, sizeof md_path, "%s/tables.md", f->report);
+    f->md = read_all(md_path);
+    char *echoed = read_all(echo_path);
+    int same = !strcmp(echoed, f->md);
+    free(echoed);
+    *state = f;
+    return same ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    fixture *f = *state;
+    free(f->md);
+    tu_remove_tree(f->dir);
+    free(f);
+    return 0;
+}
+
+/* The text of the block headed `heading`, up to the next heading. */
+static char *section(const char *md, const char *heading)
+{
+    const char *start = strstr(md, heading);
+    if (!start) fail_msg("no section \"%s\"", heading);
+    const char *end = strstr(start + strlen(heading), "\n### ");
+    size_t n = end ? (size_t)(end - start) : strlen(start);
+    char *s = malloc(n + 1);
+    memcpy(s, start, n);
+    s[n] = '\0';
+    return s;
+}
+
+static void assert_contains(const char *text, const char *needle)
+{
+    if (!strstr(text, needle)) fail_msg("expected \"%s\" in:\n%s", needle, text);
+}
+
+static void test_md_sequence_block_bold_and_dash(void **state)
+{
+    fixture *f = *state;
+    char *horse = section(f->md, "### anim / horse");
+    char row[512];
+    expect an = expected(1, 0), nn = expected(1, 1), dsr = expected(1, 2);
+    /* DSR is best everywhere; rank ties across methods, so all bold. */
+    md_row("AN", &an, 0x2, 0, row, sizeof row);
+    assert_contains(horse, row);
+    md_row("NN", &nn, 0x2, 1, row, sizeof row);
+    assert_contains(horse, row);
+    md_row("DSR", &dsr, 0xF, 0, row, sizeof row);
+    assert_contains(horse, row);
+    assert_contains(horse, "role: test · pairs: 2 · seeds: 0, 1");
+    free(horse);
+}
+
+static void test_md_failed_method_shows_status(void **state)
+{
+    fixture *f = *state;
+    char *camel = section(f->md, "### anim / camel");
+    assert_contains(camel, "| DSR | *failed* | *failed* | *failed* | *failed* |");
+    assert_contains(camel, "- DSR: failed — seed 0: loss became NaN at iteration 7");
+    free(camel);
+}
+
+static void test_md_mean_over_test_sequences_only(void **state)
+{
+    fixture *f = *state;
+    char *mean = section(f->md, "### anim / MEAN");
+    const int tests[] = {1, 2}, all[] = {0, 1, 2};
+    char row[512];
+    expect an = expected_mean(tests, 2, 0), nn = expected_mean(tests, 2, 1);
+    md_row("AN", &an, 0xF, 0, row, sizeof row);
+    assert_contains(mean, row);
+    md_row("NN", &nn, 0x2, 1, row, sizeof row);
+    assert_contains(mean, row);
+    /* The validation sequence must not leak into the mean. */
+    expect with_cat = expected_mean(all, 3, 0);
+    md_row("AN", &with_cat, 0xF, 0, row, sizeof row);
+    assert_null(strstr(mean, row));
+    /* A method failed on one test sequence gets no MEAN numbers. */
+    assert_contains(mean, "| DSR | *failed* | *failed* | *failed* | *failed* |");
+    assert_contains(mean, "- DSR: failed (1/2 test sequences) — camel: seed 0: loss became NaN");
+    assert_contains(mean, "2 test sequences (camel, horse)");
+    free(mean);
+    char *ama = section(f->md, "### ama / MEAN");
+    assert_contains(ama, "No test sequence");
+    assert_null(strstr(ama, "| AN |"));
+    free(ama);
+}
+
+/* ------------------------------------------------------------------ CSV */
+
+typedef struct csv_row {
+    char field[17][64];
+} csv_row;
+
+/* Plain comma splitting: the fake run's names need no CSV quoting. */
+static int parse_csv(const char *text, csv_row *rows, int max)
+{
+    int n = 0;
+    for (const char *line = text; *line && n < max; n++) {
+        const char *end = strchr(line, '\n'), *p = line;
+        int f = 0;
+        for (;; f++) {
+            const char *stop = p;
+            while (stop < end && *stop != ',') stop++;
+            if (f < 17) snprintf(rows[n].field[f], 64, "%.*s", (int)(stop - p), p);
+            if (stop == end) break;
+            p = stop + 1;
+        }
+        assert_int_equal(f + 1, 17);
+        line = end + 1;
+    }
+    return n;
+}
+
+static const csv_row *find_csv(const csv_row *rows, int n, const char *seq, const char *method)
+{
+    for (int k = 1; k < n; k++)
+        if (!strcmp(rows[k].field[1], seq) && !strcmp(rows[k].field[3], method)) return &rows[k];
+    fail_msg("no CSV row %s/%s", seq, method);
+    return NULL;
+}
+
+static void assert_csv_values(const csv_row *r, const expect *e, int has_cd)
+{
+    for (int j = 0; j < 4; j++) {
+        const char *mean = r->field[7 + 2 * j], *std = r->field[8 + 2 * j];
+        if (j == 3 && !has_cd) {
+            assert_string_equal(mean, "");
+            assert_string_equal(std, "");
+            continue;
+        }
+        double half_ulp = 0.5 * pow(10, -DECIMALS[j]) + 1e-12;
+        assert_true(fabs(strtod(mean, NULL) - e->mean[j]) <= half_ulp);
+        assert_true(fabs(strtod(std, NULL) - e->std[j]) <= half_ulp);
+    }
+}
+
+static void test_csv_parses_back(void **state)
+{
+    fixture *f = *state;
+    char path[4096];
+    snprintf(path, sizeof path, "%s/results.csv", f->report);
+    char *text = read_all(path);
+    csv_row *rows = calloc(64, sizeof *rows);
+    int n = parse_csv(text, rows, 64);
+    /* header + 4 sequences × 3 methods + anim's 3 MEAN rows */
+    assert_int_equal(n, 1 + 12 + 3);
+    assert_string_equal(rows[0].field[7], "sl2_x1e3_mean");
+    expect an = expected(1, 0), nn = expected(1, 1);
+    const csv_row *r = find_csv(rows, n, "horse", "AN");
+    assert_string_equal(r->field[2], "test");
+    assert_string_equal(r->field[4], "ok");
+    assert_string_equal(r->field[5], "2");
+    assert_string_equal(r->field[6], "2");
+    assert_csv_values(r, &an, 1);
+    assert_csv_values(find_csv(rows, n, "horse", "NN"), &nn, 0);
+    const int tests[] = {1, 2};
+    expect mean = expected_mean(tests, 2, 0);
+    r = find_csv(rows, n, "MEAN", "AN");
+    assert_string_equal(r->field[2], "mean");
+    assert_csv_values(r, &mean, 1);
+    r = find_csv(rows, n, "camel", "DSR");
+    assert_string_equal(r->field[4], "failed");
+    assert_string_equal(r->field[7], "");
+    free(rows);
+    free(text);
+}
+
+/* ----------------------------------------------------------- TeX, PNG */
+
+static void test_tex_uses_booktabs(void **state)
+{
+    fixture *f = *state;
+    char path[4096];
+    snprintf(path, sizeof path, "%s/tables.tex", f->report);
+    char *tex = read_all(path);
+    assert_contains(tex, "\\toprule");
+    assert_contains(tex, "\\midrule");
+    assert_contains(tex, "\\bottomrule");
+    assert_contains(tex, "m\\_sL2 $\\downarrow$");
+    expect dsr = expected(1, 2);
+    char best[128];
+    snprintf(best, sizeof best, "\\textbf{%.2f $\\pm$ %.2f}", dsr.mean[0], dsr.std[0]);
+    assert_contains(tex, best);
+    free(tex);
+}
+
+static unsigned be32(const unsigned char *p)
+{
+    return (unsigned)p[0] << 24 | (unsigned)p[1] << 16 | (unsigned)p[2] << 8 | p[3];
+}
+
+static void test_pngs_are_valid(void **state)
+{
+    fixture *f = *state;
+    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    for (int s = 0; s < N_SEQS; s++) {
+        char path[4096];
+        snprintf(path, sizeof path, "%s/pck_%s_%s.png", f->report, SEQS[s].dataset, SEQS[s].name);
+        FILE *fp = fopen(path, "rb");
+        assert_non_null(fp);
+        unsigned char head[24];
+        assert_int_equal(fread(head, 1, sizeof head, fp), sizeof head);
+        fclose(fp);
+        assert_memory_equal(head, sig, 8);
+        assert_memory_equal(head + 12, "IHDR", 4);
+        assert_int_equal(be32(head + 16), 900);
+        assert_int_equal(be32(head + 20), 600);
+    }
+    /* Nothing but the published outputs: no temporaries left behind. */
+    DIR *d = opendir(f->report);
+    assert_non_null(d);
+    int n = 0;
+    for (struct dirent *e; (e = readdir(d));) {
+        if (e->d_name[0] == '.') continue;
+        assert_null(strstr(e->d_name, ".tmp-"));
+        n++;
+    }
+    closedir(d);
+    assert_int_equal(n, 3 + N_SEQS);
+}
+
+static void test_empty_run_is_an_error(void **state)
+{
+    (void)state;
+    char dir[512], cells[4096];
+    tu_make_tmpdir(dir, sizeof dir);
+    tcb_error err = {0};
+    assert_int_equal(tcb_report_write(dir, NULL, NULL, &err), TCB_ERR_IO);
+    snprintf(cells, sizeof cells, "%s/cells", dir);
+    assert_int_equal(tcb_mkdirs(cells, &err), TCB_OK);
+    assert_int_equal(tcb_report_write(dir, NULL, NULL, &err), TCB_ERR_INPUT);
+    assert_non_null(strstr(err.msg, "no cell files"));
+    tu_remove_tree(dir);
+}
+
+/* Fontconfig, which cairo uses to find fonts, keeps its configuration until
+ * FcFini, which nothing calls at exit: not a leak of ours. */
+const char *__lsan_default_suppressions(void);
+const char *__lsan_default_suppressions(void) { return "leak:libfontconfig.so\n"; }
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_md_sequence_block_bold_and_dash),
+        cmocka_unit_test(test_md_failed_method_shows_status),
+        cmocka_unit_test(test_md_mean_over_test_sequences_only),
+        cmocka_unit_test(test_csv_parses_back),
+        cmocka_unit_test(test_tex_uses_booktabs),
+        cmocka_unit_test(test_pngs_are_valid),
+    };
+    const struct CMUnitTest standalone[] = {cmocka_unit_test(test_empty_run_is_an_error)};
+    int failed = cmocka_run_group_tests(tests, setup, teardown);
+    return failed + cmocka_run_group_tests(standalone, NULL, NULL);
+}

@@ -1,0 +1,385 @@
+/* The results store: cell files round trip, malformed files are rejected
+ * with the file and key named, scans come back sorted, saves leave no
+ * temporaries behind. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tcb/fsutil.h"
+#include "tcb/json.h"
+#include "tcb/results.h"
+#include "testutil.h"
+
+/* A fully populated cell; with_cd = 0 models a method without reconstruction. */
+static void make_cell(tcb_cell_result *c, const char *dataset, const char *sequence,
+                      const char *method, int seed, int with_cd, tcb_pair_record *pairs)
+{
+    memset(c, 0, sizeof *c);
+    snprintf(c->dataset, sizeof c->dataset, "%s", dataset);
+    snprintf(c->sequence, sizeof c->sequence, "%s", sequence);
+    snprintf(c->role, sizeof c->role, "test");
+    snprintf(c->method, sizeof c->method, "%s", method);
+    snprintf(c->method_impl, sizeof c->method_impl, "atlas");
+    c->params_json = "{\"lr\":0.001,\"patches\":10,\"name\":\"x\"}";
+    c->seed = seed;
+    c->status = TCB_CELL_OK;
+    snprintf(c->git_revision, sizeof c->git_revision, "abc1234");
+    c->load_s = 0.25, c->fit_s = 12.5, c->eval_s = 1.0 / 3.0;
+    c->peak_rss_kb = 123456;
+    snprintf(c->split_path, sizeof c->split_path, "splits/%s/%s.json", dataset, sequence);
+    c->split_seed = 2021;
+    c->n_pairs = 3;
+    c->pairs = pairs;
+    tcb_summary_init(&c->summary);
+    for (int p = 0; p < 3; p++) {
+        tcb_pair_metrics m = {0};
+        for (int k = 0; k < 4; k++) {
+            double e = 0.01 * (p + 1) + 0.001 * k;
+            tcb_stat_push(&m.sl2, e);
+            tcb_stat_push(&m.sl2sq, e * e);
+            tcb_stat_push(&m.rank, 0.1 * k);
+        }
+        for (int s = 0; s < TCB_PCK_STEPS; s++) m.pck[s] = s / 99.0;
+        m.auc = 0.5 + 0.1 * p;
+        double cd = with_cd ? 1e-4 * (p + 1) / 3.0 : NAN;
+        pairs[p] = (tcb_pair_record){p, (p + 2) % 5, m.sl2, m.sl2sq, m.rank, m.auc, cd};
+        tcb_summary_add_pair(&c->summary, &m, cd);
+    }
+}
+
+static void assert_stat_equal(const tcb_stat *a, const tcb_stat *b)
+{
+    assert_true(a->n == b->n);
+    assert_true(a->mean == b->mean);
+    assert_true(a->m2 == b->m2);
+}
+
+static void assert_cells_equal(const tcb_cell_result *a, const tcb_cell_result *b)
+{
+    assert_string_equal(a->dataset, b->dataset);
+    assert_string_equal(a->sequence, b->sequence);
+    assert_string_equal(a->role, b->role);
+    assert_string_equal(a->method, b->method);
+    assert_string_equal(a->method_impl, b->method_impl);
+    assert_string_equal(a->params_json, b->params_json);
+    assert_int_equal(a->seed, b->seed);
+    assert_int_equal(a->status, b->status);
+    assert_string_equal(a->message, b->message);
+    assert_string_equal(a->git_revision, b->git_revision);
+    assert_true(a->load_s == b->load_s && a->fit_s == b->fit_s && a->eval_s == b->eval_s);
+    assert_int_equal(a->peak_rss_kb, b->peak_rss_kb);
+    assert_string_equal(a->split_path, b->split_path);
+    assert_true(a->split_seed == b->split_seed);
+    assert_int_equal(a->n_pairs, b->n_pairs);
+    for (int p = 0; p < a->n_pairs; p++) {
+        const tcb_pair_record *x = &a->pairs[p], *y = &b->pairs[p];
+        assert_int_equal(x->i, y->i);
+        assert_int_equal(x->j, y->j);
+        assert_stat_equal(&x->sl2, &y->sl2);
+        assert_stat_equal(&x->sl2sq, &y->sl2sq);
+        assert_stat_equal(&x->rank, &y->rank);
+        assert_true(x->auc == y->auc);
+        assert_true(isnan(x->cd) ? isnan(y->cd) : x->cd == y->cd);
+    }
+    const tcb_summary *s = &a->summary, *t = &b->summary;
+    assert_int_equal(s->n_pairs, t->n_pairs);
+    assert_stat_equal(&s->sl2, &t->sl2);
+    assert_stat_equal(&s->sl2sq, &t->sl2sq);
+    assert_stat_equal(&s->rank, &t->rank);
+    assert_stat_equal(&s->auc, &t->auc);
+    assert_stat_equal(&s->cd, &t->cd);
+    assert_memory_equal(s->pck, t->pck, sizeof s->pck);
+}
+
+static void round_trip(int with_cd)
+{
+    char dir[512], path[4096];
+    tu_make_tmpdir(dir, sizeof dir);
+    tcb_pair_record pairs[3];
+    tcb_cell_result c, back;
+    tcb_error err = {0};
+    make_cell(&c, "anim", "horse", "OUR", 3, with_cd, pairs);
+    assert_int_equal(tcb_cell_path(path, sizeof path, dir, "anim", "horse", "OUR", 3, &err), 0);
+    assert_int_equal(tcb_cell_save(path, &c, &err), TCB_OK);
+    assert_int_equal(tcb_cell_load(path, &back, &err), TCB_OK);
+    assert_cells_equal(&c, &back);
+    assert_true(with_cd ? back.summary.cd.n == 3 : back.summary.cd.n == 0);
+    tcb_cell_free(&back);
+    tu_remove_tree(dir);
+}
+
+static void test_round_trip_with_cd(void **state)
+{
+    (void)state;
+    round_trip(1);
+}
+
+static void test_round_trip_without_cd(void **state)
+{
+    (void)state;
+    round_trip(0);
+}
+
+static void test_failed_cell_round_trip(void **state)
+{
+    (void)state;
+    char dir[512], path[4096];
+    tu_make_tmpdir(dir, sizeof dir);
+    tcb_cell_result c, back;
+    tcb_error err = {0};
+    tcb_pair_record pairs[3];
+    make_cell(&c, "ama", "crane", "DSR", 0, 1, pairs);
+    c.status = TCB_CELL_DIVERGED;
+    c.n_pairs = 0;
+    c.pairs = NULL;
+    tcb_summary_init(&c.summary);
+    c.summary.sl2.mean = NAN; /* non-finite metrics are stored as null */
+    snprintf(c.message, sizeof c.message, "loss is NaN at iteration 12");
+    assert_int_equal(tcb_cell_path(path, sizeof path, dir, "ama", "crane", "DSR", 0, &err), 0);
+    assert_int_equal(tcb_cell_save(path, &c, &err), TCB_OK);
+    assert_int_equal(tcb_cell_load(path, &back, &err), TCB_OK);
+    assert_int_equal(back.status, TCB_CELL_DIVERGED);
+    assert_string_equal(back.message, "loss is NaN at iteration 12");
+    assert_true(isnan(back.summary.sl2.mean));
+    assert_int_equal(back.n_pairs, 0);
+    assert_null(back.pairs);
+    tcb_cell_free(&back);
+    tu_remove_tree(dir);
+}
+
+static void test_save_leaves_no_temporaries(void **state)
+{
+    (void)state;
+    char dir[512], path[4096], cell_dir[4096];
+    tu_make_tmpdir(dir, sizeof dir);
+    tcb_pair_record pairs[3];
+    tcb_cell_result c;
+    tcb_error err = {0};
+    make_cell(&c, "anim", "cat", "AN", 0, 1, pairs);
+    assert_int_equal(tcb_cell_path(path, sizeof path, dir, "anim", "cat", "AN", 0, &err), 0);
+    assert_int_equal(tcb_cell_save(path, &c, &err), TCB_OK);
+    assert_int_equal(tcb_cell_save(path, &c, &err), TCB_OK); /* overwrite */
+    snprintf(cell_dir, sizeof cell_dir, "%s/cells/anim/cat/AN", dir);
+    DIR *d = opendir(cell_dir);
+    assert_non_null(d);
+    int n = 0;
+    for (struct dirent *e; (e = readdir(d));) {
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+        assert_string_equal(e->d_name, "seed_0.json");
+        n++;
+    }
+    closedir(d);
+    assert_int_equal(n, 1);
+    tu_remove_tree(dir);
+}
+
+static void test_cell_path_rejects_escapes(void **state)
+{
+    (void)state;
+    char path[4096];
+    tcb_error err = {0};
+    assert_int_equal(tcb_cell_path(path, sizeof path, "run", "a/b", "s", "m", 0, &err),
+                     TCB_ERR_INPUT);
+    assert_int_equal(tcb_cell_path(path, sizeof path, "run", "d", "..", "m", 0, &err),
+                     TCB_ERR_INPUT);
+    assert_int_equal(tcb_cell_path(path, sizeof path, "run", "d", "s", "m", 7, &err), TCB_OK);
+    assert_string_equal(path, "run/cells/d/s/m/seed_7.json");
+}
+
+/* ------------------------------------------------------ malformed files */
+
+typedef void (*json_edit)(cJSON *root);
+
+/* Saves a valid cell, applies `edit` to its JSON, and expects loading to
+ * fail with TCB_ERR_INPUT naming the file and `key`. */
+static void expect_rejected(json_edit edit, const char *key)
+{
+    char dir[512], path[4096];
+    tu_make_tmpdir(dir, sizeof dir);
+    tcb_pair_record pairs[3];
+    tcb_cell_result c, back;
+    tcb_error err = {0};
+    make_cell(&c, "anim", "cat", "AN", 0, 1, pairs);
+    assert_int_equal(tcb_cell_path(path, sizeof path, dir, "anim", "cat", "AN", 0, &err), 0);
+    assert_int_equal(tcb_cell_save(path, &c, &err), TCB_OK);
+    cJSON *root;
+    assert_int_equal(tcb_json_load(path, &root, &err), TCB_OK);
+    edit(root);
+    assert_int_equal(tcb_json_save(path, root, &err), TCB_OK);
+    cJSON_Delete(root);
+    assert_int_equal(tcb_cell_load(path, &back, &err), TCB_ERR_INPUT);
+    if (!strstr(err.msg, path) || !strstr(err.msg, key))
+        fail_msg("message \"%s\" does not name %s and %s", err.msg, path, key);
+    assert_null(back.pairs);
+    assert_null(back.params_json);
+    tu_remove_tree(dir);
+}
+
+static void drop_status(cJSON *r) { cJSON_DeleteItemFromObject(r, "status"); }
+static void seed_as_string(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(r, "seed", cJSON_CreateString("0"));
+}
+static void wrong_format(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(r, "format", cJSON_CreateString("tcbench-cell/0"));
+}
+static void unknown_status(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(r, "status", cJSON_CreateString("meh"));
+}
+static void mean_as_string(cJSON *r)
+{
+    cJSON *sl2 = cJSON_GetObjectItem(cJSON_GetObjectItem(r, "summary"), "sl2");
+    cJSON_ReplaceItemInObject(sl2, "mean", cJSON_CreateString("0.1"));
+}
+static void short_pck(cJSON *r)
+{
+    cJSON_DeleteItemFromArray(cJSON_GetObjectItem(cJSON_GetObjectItem(r, "summary"), "pck"), 0);
+}
+static void drop_pair(cJSON *r) { cJSON_DeleteItemFromArray(cJSON_GetObjectItem(r, "pairs"), 1); }
+static void extra_key(cJSON *r) { cJSON_AddNumberToObject(r, "colour", 3); }
+static void params_as_array(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(r, "params", cJSON_CreateArray());
+}
+static void drop_fit_time(cJSON *r)
+{
+    cJSON_DeleteItemFromObject(cJSON_GetObjectItem(r, "timings"), "fit_s");
+}
+
+static void test_rejects_missing_key(void **state)
+{
+    (void)state;
+    expect_rejected(drop_status, "status");
+    expect_rejected(drop_fit_time, "timings.fit_s");
+}
+
+static void test_rejects_wrong_type(void **state)
+{
+    (void)state;
+    expect_rejected(seed_as_string, "seed");
+    expect_rejected(mean_as_string, "summary.sl2.mean");
+    expect_rejected(params_as_array, "params");
+    expect_rejected(unknown_status, "status");
+}
+
+static void test_rejects_wrong_format(void **state)
+{
+    (void)state;
+    expect_rejected(wrong_format, "format");
+}
+
+static void test_rejects_inconsistent_shapes(void **state)
+{
+    (void)state;
+    expect_rejected(short_pck, "summary.pck");
+    expect_rejected(drop_pair, "pairs");
+    expect_rejected(extra_key, "colour");
+}
+
+static void test_rejects_bad_json(void **state)
+{
+    (void)state;
+    char dir[512], path[4096];
+    tu_make_tmpdir(dir, sizeof dir);
+    tu_write_text(dir, "seed_0.json", "{\"format\": \"tcbench-cell/1\",\n  \"dataset\": }\n", path,
+                  sizeof path);
+    tcb_cell_result c;
+    tcb_error err = {0};
+    assert_int_equal(tcb_cell_load(path, &c, &err), TCB_ERR_INPUT);
+    assert_non_null(strstr(err.msg, path));
+    assert_non_null(strstr(err.msg, ":2:"));
+    tu_remove_tree(dir);
+}
+
+/* ------------------------------------------------------------------ scan */
+
+static void test_scan_sorts_and_skips_non_cells(void **state)
+{
+    (void)state;
+    char dir[512], path[4096], junk[4096];
+    tu_make_tmpdir(dir, sizeof dir);
+    static const struct { const char *d, *s, *m; int seed; } order[] = {
+        {"ama", "crane", "OUR", 0},    {"anim", "cat", "AN", 2},  {"anim", "cat", "AN", 10},
+        {"anim", "cat", "OUR", 0},     {"anim", "horse", "AN", 0},
+    };
+    const int n_cells = (int)(sizeof order / sizeof order[0]);
+    tcb_error err = {0};
+    for (int k = n_cells - 1; k >= 0; k--) { /* written out of order */
+        int w = (k * 3) % n_cells;
+        tcb_pair_record pairs[3];
+        tcb_cell_result c;
+        make_cell(&c, order[w].d, order[w].s, order[w].m, order[w].seed, w % 2, pairs);
+        assert_int_equal(tcb_cell_path(path, sizeof path, dir, order[w].d, order[w].s, order[w].m,
+                                       order[w].seed, &err), 0);
+        assert_int_equal(tcb_cell_save(path, &c, &err), TCB_OK);
+    }
+    /* Neither an atomic-write leftover nor a non-JSON file is a cell. */
+    snprintf(junk, sizeof junk, "%s/cells/anim/cat/AN", dir);
+    tu_write_text(junk, "seed_3.json.tmp-abc123", "{", path, sizeof path);
+    tu_write_text(junk, "notes.txt", "hello", path, sizeof path);
+    tcb_cell_result *cells;
+    int n;
+    assert_int_equal(tcb_results_scan(dir, &cells, &n, &err), TCB_OK);
+    assert_int_equal(n, n_cells);
+    for (int k = 0; k < n; k++) {
+        assert_string_equal(cells[k].dataset, order[k].d);
+        assert_string_equal(cells[k].sequence, order[k].s);
+        assert_string_equal(cells[k].method, order[k].m);
+        assert_int_equal(cells[k].seed, order[k].seed);
+        tcb_cell_free(&cells[k]);
+    }
+    free(cells);
+    tu_remove_tree(dir);
+}
+
+static void test_scan_rejects_misplaced_and_missing(void **state)
+{
+    (void)state;
+    char dir[512], path[4096], other[4096];
+    tu_make_tmpdir(dir, sizeof dir);
+    tcb_cell_result *cells;
+    int n;
+    tcb_error err = {0};
+    assert_int_equal(tcb_results_scan(dir, &cells, &n, &err), TCB_ERR_IO); /* no cells/ */
+    tcb_pair_record pairs[3];
+    tcb_cell_result c;
+    make_cell(&c, "anim", "cat", "AN", 0, 1, pairs);
+    /* A cell copied under another seed's name would be counted twice. */
+    snprintf(other, sizeof other, "%s/cells/anim/cat/AN/seed_1.json", dir);
+    assert_int_equal(tcb_cell_save(other, &c, &err), TCB_OK);
+    assert_int_equal(tcb_results_scan(dir, &cells, &n, &err), TCB_ERR_INPUT);
+    assert_non_null(strstr(err.msg, other));
+    assert_int_equal(tcb_cell_path(path, sizeof path, dir, "anim", "cat", "AN", 0, &err), 0);
+    assert_non_null(strstr(err.msg, path));
+    assert_null(cells);
+    tu_remove_tree(dir);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_round_trip_with_cd),
+        cmocka_unit_test(test_round_trip_without_cd),
+        cmocka_unit_test(test_failed_cell_round_trip),
+        cmocka_unit_test(test_save_leaves_no_temporaries),
+        cmocka_unit_test(test_cell_path_rejects_escapes),
+        cmocka_unit_test(test_rejects_missing_key),
+        cmocka_unit_test(test_rejects_wrong_type),
+        cmocka_unit_test(test_rejects_wrong_format),
+        cmocka_unit_test(test_rejects_inconsistent_shapes),
+        cmocka_unit_test(test_rejects_bad_json),
+        cmocka_unit_test(test_scan_sorts_and_skips_non_cells),
+        cmocka_unit_test(test_scan_rejects_misplaced_and_missing),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,320 @@
+/* Evaluation splits (make, save/load, obtain) and training-pair samplers. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "testutil.h"
+#include "tcb/fsutil.h"
+#include "tcb/split.h"
+
+static void make_ok(const char *seq, tcb_role role, int n_frames, int n_pairs, uint64_t seed,
+                    tcb_split *s)
+{
+    tcb_error err = {0};
+    if (tcb_split_make("anim", seq, role, n_frames, n_pairs, seed, s, &err))
+        fail_msg("make: %s", err.msg);
+}
+
+static void expect_error(int rc, const tcb_error *err, int code, const char *a, const char *b)
+{
+    assert_int_equal(rc, code);
+    if (a && !strstr(err->msg, a)) fail_msg("'%s' does not name '%s'", err->msg, a);
+    if (b && !strstr(err->msg, b)) fail_msg("'%s' does not name '%s'", err->msg, b);
+}
+
+static void test_make_deterministic_and_valid(void **state)
+{
+    (void)state;
+    static const int frames[] = {2, 3, 35, 175};
+    for (size_t f = 0; f < 4; f++) {
+        tcb_split a, b, c, d;
+        make_ok("cat_walk", TCB_ROLE_TEST, frames[f], 500, 2021, &a);
+        make_ok("cat_walk", TCB_ROLE_TEST, frames[f], 500, 2021, &b);
+        make_ok("cat_walk", TCB_ROLE_TEST, frames[f], 500, 2022, &c);
+        make_ok("horse_gallop", TCB_ROLE_TEST, frames[f], 500, 2021, &d);
+        assert_memory_equal(a.pairs, b.pairs, 500 * 2 * sizeof(int32_t));
+        if (frames[f] > 2) { /* with 2 frames there are only two possible pairs */
+            assert_memory_not_equal(a.pairs, c.pairs, 500 * 2 * sizeof(int32_t));
+            assert_memory_not_equal(a.pairs, d.pairs, 500 * 2 * sizeof(int32_t));
+        }
+        for (int p = 0; p < 500; p++) {
+            assert_in_range(a.pairs[2 * p], 0, frames[f] - 1);
+            assert_in_range(a.pairs[2 * p + 1], 0, frames[f] - 1);
+            assert_int_not_equal(a.pairs[2 * p], a.pairs[2 * p + 1]);
+        }
+        assert_string_equal(a.dataset, "anim");
+        assert_string_equal(a.sequence, "cat_walk");
+        assert_int_equal(a.n_frames, frames[f]);
+        tcb_split_free(&a), tcb_split_free(&b), tcb_split_free(&c), tcb_split_free(&d);
+    }
+}
+
+/* i uniform over 5 frames, j uniform over the other 4: all 20 ordered pairs
+ * equally likely. Pearson χ² with 19 degrees of freedom has mean 19; 60 is
+ * beyond its 99.999th percentile, so a correct sampler passes with this fixed
+ * seed and a biased one (say j = i + 1 mod n) fails by thousands. */
+static void test_make_uniform(void **state)
+{
+    (void)state;
+    enum { N = 5, P = 20000 };
+    tcb_split s;
+    make_ok("cat_walk", TCB_ROLE_TEST, N, P, 7, &s);
+    int count[N][N] = {{0}};
+    for (int p = 0; p < P; p++) count[s.pairs[2 * p]][s.pairs[2 * p + 1]]++;
+    double expected = P / (double)(N * (N - 1)), chi2 = 0.0;
+    for (int i = 0; i < N; i++)
+        for (int j = 0; j < N; j++)
+            if (i != j) chi2 += (count[i][j] - expected) * (count[i][j] - expected) / expected;
+    if (chi2 > 60.0) fail_msg("chi^2 = %g over 19 degrees of freedom", chi2);
+    tcb_split_free(&s);
+}
+
+static void test_make_rejects(void **state)
+{
+    (void)state;
+    tcb_split s;
+    tcb_error err = {0};
+    expect_error(tcb_split_make("anim", "one", TCB_ROLE_TEST, 1, 10, 0, &s, &err), &err,
+                 TCB_ERR_INPUT, "one", "2 frames");
+    expect_error(tcb_split_make("anim", "x", TCB_ROLE_TEST, 5, -1, 0, &s, &err), &err,
+                 TCB_ERR_INPUT, "x", "negative");
+}
+
+static void test_save_load_roundtrip(void **state)
+{
+    (void)state;
+    char dir[256], path[512], *text;
+    tu_make_tmpdir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/sub/cat.json", dir);
+    tcb_split s, t;
+    tcb_error err = {0};
+    make_ok("cat_walk", TCB_ROLE_VALIDATION, 35, 500, 9007199254740992ULL, &s);
+    assert_int_equal(tcb_split_save(path, &s, &err), TCB_OK);
+    assert_int_equal(tcb_split_load(path, &t, &err), TCB_OK);
+    assert_string_equal(t.dataset, "anim");
+    assert_string_equal(t.sequence, "cat_walk");
+    assert_int_equal(t.role, TCB_ROLE_VALIDATION);
+    assert_int_equal(t.n_frames, 35);
+    assert_true(t.seed == 9007199254740992ULL);
+    assert_int_equal(t.n_pairs, 500);
+    assert_memory_equal(s.pairs, t.pairs, 500 * 2 * sizeof(int32_t));
+    assert_int_equal(tcb_read_file(path, &text, NULL, &err), TCB_OK);
+    assert_non_null(strstr(text, "\"tcbench-split/1\""));
+    free(text);
+
+    s.seed = 9007199254740993ULL; /* not representable in a JSON number */
+    expect_error(tcb_split_save(path, &s, &err), &err, TCB_ERR_INPUT, path, "seed");
+    tcb_split_free(&s), tcb_split_free(&t);
+    tu_remove_tree(dir);
+}
+
+static void file_identity(const char *path, struct stat *st, char **text)
+{
+    assert_int_equal(stat(path, st), 0);
+    assert_int_equal(tcb_read_file(path, text, NULL, NULL), TCB_OK);
+}
+
+static void test_obtain_reuses(void **state)
+{
+    (void)state;
+    char dir[256], path[512], *before, *after;
+    tu_make_tmpdir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/splits/anim/cat_walk.json", dir);
+    tcb_split a, b;
+    tcb_error err = {0};
+    assert_int_equal(tcb_split_obtain(path, "anim", "cat_walk", TCB_ROLE_TEST, 35, 100, 3, &a, &err),
+                     TCB_OK);
+    struct stat st1, st2;
+    file_identity(path, &st1, &before);
+    assert_int_equal(tcb_split_obtain(path, "anim", "cat_walk", TCB_ROLE_TEST, 35, 100, 3, &b, &err),
+                     TCB_OK);
+    file_identity(path, &st2, &after);
+    assert_true(st1.st_ino == st2.st_ino); /* an atomic rewrite would be a new inode */
+    assert_true(st1.st_mtim.tv_sec == st2.st_mtim.tv_sec &&
+                st1.st_mtim.tv_nsec == st2.st_mtim.tv_nsec);
+    assert_string_equal(before, after);
+    assert_memory_equal(a.pairs, b.pairs, 100 * 2 * sizeof(int32_t));
+    tcb_split_free(&a), tcb_split_free(&b);
+    free(before), free(after);
+
+    /* The file is the authority: its pairs are used, not redrawn ones. */
+    tu_write_text(dir, "edited.json",
+                  "{\"format\": \"tcbench-split/1\", \"dataset\": \"anim\", \"sequence\": \"cat\","
+                  " \"role\": \"test\", \"n_frames\": 4, \"seed\": 1, \"n_pairs\": 2,"
+                  " \"pairs\": [[3, 0], [3, 0]]}",
+                  path, sizeof path);
+    assert_int_equal(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_TEST, 4, 2, 1, &a, &err), TCB_OK);
+    assert_true(a.pairs[0] == 3 && a.pairs[1] == 0 && a.pairs[2] == 3 && a.pairs[3] == 0);
+    tcb_split_free(&a);
+    tu_remove_tree(dir);
+}
+
+static void test_obtain_disagreement(void **state)
+{
+    (void)state;
+    char dir[256], path[512];
+    tu_make_tmpdir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/cat.json", dir);
+    tcb_split s;
+    tcb_error err = {0};
+    assert_int_equal(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_TEST, 35, 50, 3, &s, &err), TCB_OK);
+    tcb_split_free(&s);
+    expect_error(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_VALIDATION, 35, 50, 3, &s, &err),
+                 &err, TCB_ERR_INPUT, path, "role");
+    assert_null(s.pairs);
+    expect_error(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_TEST, 36, 50, 3, &s, &err), &err,
+                 TCB_ERR_INPUT, path, "n_frames");
+    expect_error(tcb_split_obtain(path, "anim", "dog", TCB_ROLE_TEST, 35, 50, 3, &s, &err), &err,
+                 TCB_ERR_INPUT, path, "sequence");
+    expect_error(tcb_split_obtain(path, "ama", "cat", TCB_ROLE_TEST, 35, 50, 3, &s, &err), &err,
+                 TCB_ERR_INPUT, path, "dataset");
+    expect_error(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_TEST, 35, 500, 3, &s, &err), &err,
+                 TCB_ERR_INPUT, path, "n_pairs");
+    expect_error(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_TEST, 35, 50, 4, &s, &err), &err,
+                 TCB_ERR_INPUT, path, "seed");
+    tu_remove_tree(dir);
+}
+
+/* Each malformed file fails with TCB_ERR_INPUT naming the file and the key. */
+static void test_load_malformed(void **state)
+{
+    (void)state;
+#define HEAD "\"format\": \"tcbench-split/1\", \"dataset\": \"anim\", \"sequence\": \"cat\", "
+    static const struct {
+        const char *json, *key;
+    } cases[] = {
+        {"{" HEAD "\"role\": \"test\", \"n_frames\": 4, \"seed\": 1, \"n_pairs\": 1, "
+         "\"pairs\": [[0, 1]]", ":1:"}, /* truncated: invalid JSON */
+        {"[1, 2]", "object"},
+        {"{" HEAD "\"role\": \"test\", \"n_frames\": \"4\", \"seed\": 1, \"n_pairs\": 1, "
+         "\"pairs\": [[0, 1]]}", ".n_frames"},
+        {"{" HEAD "\"role\": \"test\", \"n_frames\": 4, \"n_pairs\": 1, \"pairs\": [[0, 1]]}",
+         ".seed"},
+        {"{" HEAD "\"role\": \"test\", \"n_frames\": 4, \"seed\": 1.5, \"n_pairs\": 1, "
+         "\"pairs\": [[0, 1]]}", ".seed"},
+        {"{" HEAD "\"role\": \"dev\", \"n_frames\": 4, \"seed\": 1, \"n_pairs\": 1, "
+         "\"pairs\": [[0, 1]]}", ".role"},
+        {"{" HEAD "\"role\": \"test\", \"n_frames\": 4, \"seed\": 1, \"n_pairs\": 1, "
+         "\"pairs\": [[0, 1]], \"extra\": 0}", ".extra"},
+        {"{\"format\": \"tcbench-split/2\", \"dataset\": \"anim\", \"sequence\": \"cat\", "
+         "\"role\": \"test\", \"n_frames\": 4, \"seed\": 1, \"n_pairs\": 1, \"pairs\": [[0, 1]]}",
+         ".format"},
+        {"{" HEAD "\"role\": \"test\", \"n_frames\": 4, \"seed\": 1, \"n_pairs\": 2, "
+         "\"pairs\": [[0, 1]]}", ".pairs"},
+        {"{" HEAD "\"role\": \"test\", \"n_frames\": 4, \"seed\": 1, \"n_pairs\": 2, "
+         "\"pairs\": [[0, 1], [2, 2]]}", "pairs[1]"},
+        {"{" HEAD "\"role\": \"test\", \"n_frames\": 4, \"seed\": 1, \"n_pairs\": 2, "
+         "\"pairs\": [[0, 1], [2, 4]]}", "pairs[1][1]"},
+        {"{" HEAD "\"role\": \"test\", \"n_frames\": 4, \"seed\": 1, \"n_pairs\": 1, "
+         "\"pairs\": [[-1, 1]]}", "pairs[0][0]"},
+        {"{" HEAD "\"role\": \"test\", \"n_frames\": 4, \"seed\": 1, \"n_pairs\": 1, "
+         "\"pairs\": [[0.5, 1]]}", "pairs[0][0]"},
+        {"{" HEAD "\"role\": \"test\", \"n_frames\": 4, \"seed\": 1, \"n_pairs\": 1, "
+         "\"pairs\": [\"0,1\"]}", "pairs[0]"},
+        {"{" HEAD "\"role\": \"test\", \"n_frames\": 4, \"seed\": 1, \"n_pairs\": 1, "
+         "\"pairs\": [[0, 1, 2]]}", "pairs[0]"},
+        {"{" HEAD "\"role\": \"test\", \"n_frames\": 4, \"seed\": 1, \"n_pairs\": 1, "
+         "\"pairs\": {\"0\": 1}}", ".pairs"},
+    };
+#undef HEAD
+    char dir[256], path[512];
+    tu_make_tmpdir(dir, sizeof dir);
+    for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
+        tu_write_text(dir, "bad.json", cases[c].json, path, sizeof path);
+        tcb_split s;
+        tcb_error err = {0};
+        expect_error(tcb_split_load(path, &s, &err), &err, TCB_ERR_INPUT, path, cases[c].key);
+        assert_null(s.pairs);
+    }
+    tcb_split s;
+    tcb_error err = {0};
+    snprintf(path, sizeof path, "%s/missing.json", dir);
+    expect_error(tcb_split_load(path, &s, &err), &err, TCB_ERR_IO, path, NULL);
+    tu_remove_tree(dir);
+}
+
+static void test_names(void **state)
+{
+    (void)state;
+    for (int r = TCB_ROLE_TRAIN; r <= TCB_ROLE_TEST; r++) {
+        tcb_role back;
+        assert_int_equal(tcb_role_parse(tcb_role_name((tcb_role)r), &back), 0);
+        assert_int_equal(back, r);
+    }
+    tcb_role role;
+    assert_int_equal(tcb_role_parse("validation", &role), 0);
+    assert_int_equal(role, TCB_ROLE_VALIDATION);
+    assert_int_equal(tcb_role_parse("val", &role), -1);
+    tcb_pair_mode mode;
+    assert_int_equal(tcb_pair_mode_parse("neighbors", &mode), 0);
+    assert_int_equal(mode, TCB_PAIRS_NEIGHBORS);
+    assert_int_equal(tcb_pair_mode_parse("random", &mode), 0);
+    assert_int_equal(mode, TCB_PAIRS_RANDOM);
+    assert_int_equal(tcb_pair_mode_parse("within_seq", &mode), 0);
+    assert_int_equal(mode, TCB_PAIRS_WITHIN_SEQ);
+    assert_int_equal(tcb_pair_mode_parse("neighbours", &mode), -1);
+}
+
+/* Draws 40 j per frame for every i (a given allowed j is then missed with
+ * probability < e^-39); every j must be allowed and every allowed j seen. */
+static void check_sampler(tcb_pair_mode mode, int delta, int n, tcb_rng *rng)
+{
+    for (int i = 0; i < n; i++) {
+        int seen[64] = {0};
+        for (int t = 0; t < 40 * n; t++) {
+            int j = tcb_pair_sample(mode, delta, n, i, rng);
+            assert_in_range(j, 0, n - 1);
+            assert_int_not_equal(j, i);
+            if (mode == TCB_PAIRS_NEIGHBORS) assert_true(abs(i - j) <= delta);
+            seen[j] = 1;
+        }
+        for (int j = 0; j < n; j++) {
+            int allowed = j != i && (mode != TCB_PAIRS_NEIGHBORS || abs(i - j) <= delta);
+            if (seen[j] != allowed)
+                fail_msg("mode %d, delta %d, %d frames, i = %d: j = %d seen %d", (int)mode,
+                         delta, n, i, j, seen[j]);
+        }
+    }
+}
+
+static void test_pair_samplers(void **state)
+{
+    (void)state;
+    tcb_rng rng;
+    tcb_rng_seed(&rng, 11);
+    static const int ns[] = {2, 3, 10, 48};
+    static const int deltas[] = {1, 2, 5, 100};
+    for (size_t a = 0; a < 4; a++) {
+        for (size_t b = 0; b < 4; b++) check_sampler(TCB_PAIRS_NEIGHBORS, deltas[b], ns[a], &rng);
+        check_sampler(TCB_PAIRS_RANDOM, 0, ns[a], &rng);
+        check_sampler(TCB_PAIRS_WITHIN_SEQ, 0, ns[a], &rng);
+    }
+    assert_int_equal(tcb_pair_sample(TCB_PAIRS_RANDOM, 1, 1, 0, &rng), -1);
+    assert_int_equal(tcb_pair_sample(TCB_PAIRS_NEIGHBORS, 1, 0, 0, &rng), -1);
+    assert_int_equal(tcb_pair_sample(TCB_PAIRS_NEIGHBORS, 0, 10, 3, &rng), -1);
+    assert_int_equal(tcb_pair_sample(TCB_PAIRS_WITHIN_SEQ, 1, 10, 10, &rng), -1);
+    assert_int_equal(tcb_pair_sample(TCB_PAIRS_WITHIN_SEQ, 1, 10, -1, &rng), -1);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_make_deterministic_and_valid),
+        cmocka_unit_test(test_make_uniform),
+        cmocka_unit_test(test_make_rejects),
+        cmocka_unit_test(test_save_load_roundtrip),
+        cmocka_unit_test(test_obtain_reuses),
+        cmocka_unit_test(test_obtain_disagreement),
+        cmocka_unit_test(test_load_malformed),
+        cmocka_unit_test(test_names),
+        cmocka_unit_test(test_pair_samplers),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
