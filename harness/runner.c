@@ -317,7 +317,8 @@ int tcb_run(const tcb_config *cfg, const tcb_run_opts *opts, tcb_run_stats *stat
     for (int k = 0; k < cfg->n_datasets && !rc; k++) {
         const tcb_dataset_spec *d = &cfg->datasets[k];
         if (root_missing(d)) {
-            tcb_report_log(&opts->reporter, TCB_LOG_INFO,
+            /* A warning, not info: a silently shorter table would mislead. */
+            tcb_report_log(&opts->reporter, TCB_LOG_WARN,
                            "dataset %s skipped: %s not found (optional)", d->name, d->root);
             continue;
         }

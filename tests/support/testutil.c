@@ -41,6 +41,20 @@ void tu_remove_tree(const char *dir)
     nftw(dir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
 }
 
+int tu_setup_tmpdir(void **state)
+{
+    static char dir[4096]; /* one test runs at a time within a program */
+    tu_make_tmpdir(dir, sizeof dir);
+    *state = dir;
+    return 0;
+}
+
+int tu_teardown_tmpdir(void **state)
+{
+    tu_remove_tree(*state);
+    return 0;
+}
+
 const char *tu_shared_data(void)
 {
     struct stat st;

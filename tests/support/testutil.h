@@ -2,7 +2,15 @@
 #ifndef TCB_TESTUTIL_H
 #define TCB_TESTUTIL_H
 
+#include <math.h>
 #include <stddef.h>
+
+/* cmocka 1.1 has no floating-point assertion: |a − b| ≤ tol, printing both. */
+#define assert_near(a, b, tol)                                                                     \
+    do {                                                                                           \
+        double a_ = (a), b_ = (b);                                                                 \
+        if (!(fabs(a_ - b_) <= (tol))) fail_msg("%s = %.17g, expected %.17g", #a, a_, b_);         \
+    } while (0)
 
 /* Creates a fresh directory under $TMPDIR (or /tmp) and writes its path to
  * out; aborts the test program on failure. */
@@ -11,6 +19,11 @@ void tu_make_tmpdir(char *out, size_t size);
 /* Writes text to dir/name (creating it); returns the full path in out. */
 void tu_write_text(const char *dir, const char *name, const char *text, char *out,
                    size_t size);
+
+/* cmocka setup/teardown giving each test a fresh temporary directory as
+ * *state (a char *), removed afterwards. */
+int tu_setup_tmpdir(void **state);
+int tu_teardown_tmpdir(void **state);
 
 /* rm -rf of a directory made by tu_make_tmpdir. */
 void tu_remove_tree(const char *dir);

@@ -17,20 +17,6 @@
 #include "tcb/sequence.h"
 #include "testutil.h"
 
-static int setup(void **state)
-{
-    static char dir[TCB_PATH_MAX];
-    tu_make_tmpdir(dir, sizeof dir);
-    *state = dir;
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    tu_remove_tree(*state);
-    return 0;
-}
-
 /* dir/frames/mesh_000k.obj: a square pyramid that widens with k. */
 static void write_frames(const char *dir, int n)
 {
@@ -267,7 +253,7 @@ static void test_load_objdir_rebuilds_stale_entry(void **state)
 
 int main(void)
 {
-#define T(f) cmocka_unit_test_setup_teardown(f, setup, teardown)
+#define T(f) cmocka_unit_test_setup_teardown(f, tu_setup_tmpdir, tu_teardown_tmpdir)
     const struct CMUnitTest tests[] = {
         T(test_round_trip_bit_exact),
         T(test_long_key),

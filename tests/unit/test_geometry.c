@@ -9,12 +9,7 @@
 #include <string.h>
 
 #include "tcb/geometry.h"
-
-#define assert_near(a, b, tol)                                                                     \
-    do {                                                                                           \
-        double a_ = (a), b_ = (b);                                                                 \
-        if (!(fabs(a_ - b_) <= (tol))) fail_msg("%s = %.17g, expected %.17g", #a, a_, b_);         \
-    } while (0)
+#include "testutil.h"
 
 /* Unit cube [0,1]^3, vertex i = (i&1, i>>1&1, i>>2&1), 12 outward triangles. */
 static const float cube_v[8 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0,

@@ -11,20 +11,6 @@
 #include "tcb/mesh.h"
 #include "testutil.h"
 
-static int setup(void **state)
-{
-    static char dir[TCB_PATH_MAX];
-    tu_make_tmpdir(dir, sizeof dir);
-    *state = dir;
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    tu_remove_tree(*state);
-    return 0;
-}
-
 static int read_text(const char *dir, const char *text, tcb_mesh *m, tcb_error *err, char *path)
 {
     tu_write_text(dir, "m.obj", text, path, TCB_PATH_MAX);
@@ -197,14 +183,14 @@ static void test_write_round_trip(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_setup_teardown(test_index_forms, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_polygons_fan, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_tolerated_syntax, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_face_before_vertices, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_bad_inputs, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_nul_byte, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_unreadable_path, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_write_round_trip, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_index_forms, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test_setup_teardown(test_polygons_fan, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test_setup_teardown(test_tolerated_syntax, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test_setup_teardown(test_face_before_vertices, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test_setup_teardown(test_bad_inputs, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test_setup_teardown(test_nul_byte, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test_setup_teardown(test_unreadable_path, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test_setup_teardown(test_write_round_trip, tu_setup_tmpdir, tu_teardown_tmpdir),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -14,12 +14,6 @@
 #include "tcb/sequence.h"
 #include "testutil.h"
 
-#define assert_near(a, b, tol)                                                                     \
-    do {                                                                                           \
-        double a_ = (a), b_ = (b);                                                                 \
-        if (!(fabs(a_ - b_) <= (tol))) fail_msg("%s = %.17g, expected %.17g", #a, a_, b_);         \
-    } while (0)
-
 /* An irregular tetrahedron: its vertex mean and surface centroid differ. */
 static const float base_v[4 * 3] = {0, 0, 0, 2, 0, 0, 0, 1, 0, 0, 0, 3};
 static const int32_t base_f[4 * 3] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
@@ -40,20 +34,6 @@ static void write_frame(const char *dir, const char *name, float scale, float dx
         n += snprintf(text + n, sizeof text - (size_t)n, "f %d %d %d\n", f[0] + 1, f[1] + 1, f[2] + 1);
     }
     tu_write_text(dir, name, text, path, sizeof path);
-}
-
-static int setup(void **state)
-{
-    static char dir[TCB_PATH_MAX];
-    tu_make_tmpdir(dir, sizeof dir);
-    *state = dir;
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    tu_remove_tree(*state);
-    return 0;
 }
 
 /* x of vertex 0 in frame f: write_frame puts it at dx. */
@@ -351,7 +331,7 @@ static void test_write_objdir_round_trip(void **state)
 
 int main(void)
 {
-#define T(f) cmocka_unit_test_setup_teardown(f, setup, teardown)
+#define T(f) cmocka_unit_test_setup_teardown(f, tu_setup_tmpdir, tu_teardown_tmpdir)
     const struct CMUnitTest tests[] = {
         T(test_order_by_last_number),
         T(test_order_zero_padded),
