@@ -6,5 +6,6 @@
 
 extern const tcb_method_ops tcb_method_oracle;
 extern const tcb_method_ops tcb_method_nearest;
+extern const tcb_method_ops tcb_method_nricp;
 
 #endif

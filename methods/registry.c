@@ -16,6 +16,7 @@
 static const tcb_method_ops *const builtins[] = {
     &tcb_method_oracle,
     &tcb_method_nearest,
+    &tcb_method_nricp,
 };
 #define N_BUILTINS ((int)(sizeof builtins / sizeof builtins[0]))
 

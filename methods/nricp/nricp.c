@@ -1,0 +1,165 @@
+/* nricp — non-rigid ICP (Thea's Register, register.h) with the four
+ * correspondence strategies of the paper's supp. "Analysis of nrICP"
+ * (reference-protocol §6.3; TCSR's names in parentheses):
+ *
+ *   random              (random)              ν_{P_j}(P_i), then the harness's
+ *                                             projection onto P_j (π_{P_j}).
+ *                                             The paper's reported nrICP rows.
+ *   propagate_simple    (propagate_many2one)  compose consecutive NN maps i → j
+ *   propagate_bijective (propagate_hungarian) the same with linear assignments
+ *   propagate_deform    (propagate_noproj)    X ← ν_{P_{k±1}}(X) through every
+ *                                             frame between i and j
+ *
+ * The clouds are the GT vertices of each frame with area-weighted vertex
+ * normals (§6.1: normals are required and only meshes have them). */
+#include <stdlib.h>
+#include <string.h>
+
+#include "methods/builtin.h"
+#include "methods/nricp/nricp_internal.h"
+#include "methods/params.h"
+#include "tcb/geometry.h"
+#include "tcb/json.h"
+
+#define WHERE "nricp.params"
+
+const char *const nricp_strategy_names[] = {"random", "propagate_simple", "propagate_bijective",
+                                            "propagate_deform", NULL};
+
+static int nricp_create(const char *params_json, void **self, tcb_error *err)
+{
+    static const char *const keys[] = {"strategy", "rounds", "smooth", "smooth_last", NULL};
+    *self = NULL;
+    cJSON *json;
+    int rc = tcb_params_parse(params_json, WHERE, keys, &json, err);
+    if (rc) return rc;
+    nricp_params p = nricp_default_params();
+    int strategy = 0;
+    long long rounds = 0, smooth = 0, smooth_last = 0;
+    rc = tcb_json_enum(json, "strategy", WHERE, 0, NRICP_RANDOM, nricp_strategy_names, &strategy, err);
+    if (!rc) rc = tcb_json_int(json, "rounds", WHERE, 0, p.rounds, 1, 10000, &rounds, err);
+    if (!rc) rc = tcb_json_int(json, "smooth", WHERE, 0, p.smooth, 0, 10000, &smooth, err);
+    if (!rc) rc = tcb_json_int(json, "smooth_last", WHERE, 0, p.smooth_last, 0, 10000, &smooth_last, err);
+    cJSON_Delete(json);
+    if (rc) return rc;
+    nricp_method *m = calloc(1, sizeof *m);
+    if (!m) return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory");
+    m->strategy = (nricp_strategy)strategy;
+    m->params = p;
+    m->params.rounds = (int)rounds, m->params.smooth = (int)smooth, m->params.smooth_last = (int)smooth_last;
+    *self = m;
+    return TCB_OK;
+}
+
+int nricp_prepare(nricp_method *m, const tcb_sequence *seq, tcb_error *err)
+{
+    if (seq->n_frames < 2 || seq->n_verts < 1)
+        return tcb_fail(err, TCB_ERR_INPUT,
+                        "nricp: sequence %s has %d frames of %d vertices (need at least 2 frames)", seq->name,
+                        seq->n_frames, seq->n_verts);
+    m->n_frames = seq->n_frames, m->n_verts = seq->n_verts;
+    m->seq_hash = nricp_sequence_hash(seq);
+    size_t frame = (size_t)seq->n_verts * 3;
+    free(m->normals);
+    m->normals = malloc((size_t)seq->n_frames * frame * sizeof *m->normals);
+    if (!m->normals) return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory for normals");
+    for (int f = 0; f < seq->n_frames; f++)
+        tcb_vertex_normals(tcb_seq_frame(seq, f), seq->n_verts, seq->faces, seq->n_faces,
+                           m->normals + f * frame);
+    return TCB_OK;
+}
+
+static int nricp_fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_error *err)
+{
+    nricp_method *m = self;
+    int rc = nricp_prepare(m, seq, err);
+    if (!rc && nricp_uses_maps(m->strategy)) rc = nricp_fit_maps(m, seq, ctx, err);
+    return rc;
+}
+
+static const float *normals_of(const nricp_method *m, int f)
+{
+    return m->normals + (size_t)f * m->n_verts * 3;
+}
+
+/* X ← ν_{P_{k±1}}(X) from frame i to frame j, X starting as src with the
+ * normals of frame i throughout (Thea writes the original normals back).
+ * TCSR loops over range(i, j), so for j < i it returned P_i unchanged;
+ * here j < i deforms through i−1, i−2, …, j. */
+static int deform_chain(const nricp_method *m, const tcb_sequence *seq, int i, int j,
+                        const float *src, float *out, tcb_error *err)
+{
+    int nv = m->n_verts, step = j > i ? 1 : -1, rc = TCB_OK;
+    memcpy(out, src, (size_t)nv * 3 * sizeof *out);
+    float *next = malloc((size_t)nv * 3 * sizeof *next);
+    if (!next) return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory");
+    for (int k = i; k != j && !rc; k += step) {
+        rc = nricp_register(out, normals_of(m, i), nv, tcb_seq_frame(seq, k + step),
+                            normals_of(m, k + step), nv, &m->params, next, err);
+        if (rc) tcb_error_prefix(err, "deforming frame %d onto frame %d: ", k, k + step);
+        else memcpy(out, next, (size_t)nv * 3 * sizeof *out);
+    }
+    free(next);
+    return rc;
+}
+
+static int compose_transfer(const nricp_method *m, const tcb_sequence *seq, int i, int j, float *out,
+                            tcb_error *err)
+{
+    int32_t *idx = malloc((size_t)m->n_verts * sizeof *idx);
+    if (!idx) return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory");
+    nricp_compose(m, i, j, idx);
+    const float *pj = tcb_seq_frame(seq, j);
+    for (int v = 0; v < m->n_verts; v++)
+        memcpy(out + 3 * (size_t)v, pj + 3 * (size_t)idx[v], 3 * sizeof *out);
+    free(idx);
+    return TCB_OK;
+}
+
+static int nricp_transfer(void *self, const tcb_sequence *seq, int i, int j, const float *src, int n,
+                          float *out, tcb_rng *rng, tcb_error *err)
+{
+    (void)rng; /* deterministic: the inputs are the GT vertices themselves */
+    const nricp_method *m = self;
+    if (!m->normals || m->n_frames != seq->n_frames || m->n_verts != seq->n_verts)
+        return tcb_fail(err, TCB_ERR_INTERNAL, "nricp: transfer before fit on sequence %s", seq->name);
+    if (i < 0 || j < 0 || i >= m->n_frames || j >= m->n_frames)
+        return tcb_fail(err, TCB_ERR_INPUT, "nricp: pair %d->%d outside frames 0..%d", i, j, m->n_frames - 1);
+    /* Normals and vertex maps exist only for whole frames of GT vertices. */
+    if (n != m->n_verts)
+        return tcb_fail(err, TCB_ERR_INPUT,
+                        "nricp: can only transfer the %d GT vertices of a frame, got %d points", m->n_verts,
+                        n);
+    switch (m->strategy) {
+    case NRICP_RANDOM:
+        return nricp_register(src, normals_of(m, i), n, tcb_seq_frame(seq, j), normals_of(m, j), n,
+                              &m->params, out, err);
+    case NRICP_SIMPLE:
+    case NRICP_BIJECTIVE:
+        return compose_transfer(m, seq, i, j, out, err);
+    case NRICP_DEFORM:
+        return deform_chain(m, seq, i, j, src, out, err);
+    }
+    return tcb_fail(err, TCB_ERR_INTERNAL, "nricp: unknown strategy %d", (int)m->strategy);
+}
+
+static void nricp_destroy(void *self)
+{
+    nricp_method *m = self;
+    if (!m) return;
+    free(m->normals);
+    free(m->maps);
+    free(m);
+}
+
+const tcb_method_ops tcb_method_nricp = {
+    .abi_version = TCB_METHOD_ABI_VERSION,
+    .name = "nricp",
+    .description = "non-rigid ICP (Thea Register: 25 rounds, smooth 3/1) with the paper's four strategies",
+    .create = nricp_create,
+    .fit = nricp_fit,
+    .transfer = nricp_transfer,
+    .save = nricp_save,
+    .load = nricp_load,
+    .destroy = nricp_destroy,
+};

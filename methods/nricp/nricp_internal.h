@@ -1,0 +1,64 @@
+/* The nricp method's state, shared by its table (nricp.c), the consecutive
+ * maps (maps.c) and the checkpoint (checkpoint.c). */
+#ifndef TCB_NRICP_INTERNAL_H
+#define TCB_NRICP_INTERNAL_H
+
+#include <stdint.h>
+
+#include "methods/nricp/register.h"
+#include "tcb/method.h"
+
+/* Reference-protocol §6.3; TCSR's names in parentheses in nricp.c. */
+typedef enum nricp_strategy {
+    NRICP_RANDOM = 0,
+    NRICP_SIMPLE = 1,
+    NRICP_BIJECTIVE = 2,
+    NRICP_DEFORM = 3
+} nricp_strategy;
+
+extern const char *const nricp_strategy_names[]; /* NULL-terminated, indexed by nricp_strategy */
+
+typedef struct nricp_method {
+    nricp_strategy strategy;
+    nricp_params params;
+    int n_frames, n_verts; /* of the fitted sequence; 0 before fit/load */
+    float *normals;        /* [n_frames][n_verts][3] area-weighted vertex normals */
+    /* Consecutive vertex maps, propagate_simple/bijective only (else NULL):
+     * [2][n_frames − 1][n_verts]; block 0 row k maps frame k → k+1, block 1
+     * row k maps frame k+1 → k. */
+    int32_t *maps;
+    uint64_t seq_hash; /* nricp_sequence_hash of the fitted sequence */
+} nricp_method;
+
+static inline int nricp_uses_maps(nricp_strategy s)
+{
+    return s == NRICP_SIMPLE || s == NRICP_BIJECTIVE;
+}
+
+static inline size_t nricp_maps_len(const nricp_method *m)
+{
+    return 2 * (size_t)(m->n_frames - 1) * (size_t)m->n_verts;
+}
+
+/* Offset in maps of the row mapping frame a to the adjacent frame b = a ± 1. */
+static inline size_t nricp_map_at(const nricp_method *m, int a, int b)
+{
+    size_t row = b > a ? (size_t)a : (size_t)(m->n_frames - 1) + (size_t)b;
+    return row * (size_t)m->n_verts;
+}
+
+/* Sizes and vertex normals of seq (fit and load both start here). */
+int nricp_prepare(nricp_method *m, const tcb_sequence *seq, tcb_error *err);
+
+/* maps.c: compute every consecutive map (OpenMP over the 2(F−1)
+ * registrations, progress through ctx->reporter), and compose them. */
+int nricp_fit_maps(nricp_method *m, const tcb_sequence *seq, const tcb_fit_ctx *ctx,
+                   tcb_error *err);
+void nricp_compose(const nricp_method *m, int i, int j, int32_t *idx);
+
+/* checkpoint.c */
+uint64_t nricp_sequence_hash(const tcb_sequence *seq); /* FNV-1a of the vertex coordinates */
+int nricp_save(void *self, const char *path, tcb_error *err);
+int nricp_load(void *self, const tcb_sequence *seq, const char *path, tcb_error *err);
+
+#endif
