@@ -7,5 +7,8 @@
 extern const tcb_method_ops tcb_method_oracle;
 extern const tcb_method_ops tcb_method_nearest;
 extern const tcb_method_ops tcb_method_nricp;
+extern const tcb_method_ops tcb_method_atlasnet;
+extern const tcb_method_ops tcb_method_dsr;
+extern const tcb_method_ops tcb_method_mca;
 
 #endif

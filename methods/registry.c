@@ -17,6 +17,9 @@ static const tcb_method_ops *const builtins[] = {
     &tcb_method_oracle,
     &tcb_method_nearest,
     &tcb_method_nricp,
+    &tcb_method_atlasnet,
+    &tcb_method_dsr,
+    &tcb_method_mca,
 };
 #define N_BUILTINS ((int)(sizeof builtins / sizeof builtins[0]))
 

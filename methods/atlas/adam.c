@@ -1,0 +1,49 @@
+#include "methods/atlas/adam.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+int tcb_atlas_adam_init(tcb_atlas_adam *a, size_t n, tcb_error *err)
+{
+    *a = (tcb_atlas_adam){.n = n, .b1 = 0.9, .b2 = 0.999, .eps = 1e-8};
+    a->m = calloc(n ? n : 1, sizeof *a->m);
+    a->v = calloc(n ? n : 1, sizeof *a->v);
+    if (!a->m || !a->v) {
+        tcb_atlas_adam_free(a);
+        return tcb_fail(err, TCB_ERR_NOMEM, "atlas: out of memory for Adam state (%zu params)", n);
+    }
+    return TCB_OK;
+}
+
+void tcb_atlas_adam_free(tcb_atlas_adam *a)
+{
+    free(a->m);
+    free(a->v);
+    a->m = a->v = NULL;
+}
+
+void tcb_atlas_adam_step(tcb_atlas_adam *a, float *params, const float *grads, double lr)
+{
+    a->t++;
+    /* The scalars in double as torch computes them in Python floats. */
+    double bc1 = 1.0 - pow(a->b1, (double)a->t), bc2 = 1.0 - pow(a->b2, (double)a->t);
+    float step = (float)(lr / bc1), sbc2 = (float)sqrt(bc2), eps = (float)a->eps;
+    float b1 = (float)a->b1, b2 = (float)a->b2;
+    float *m = a->m, *v = a->v;
+    size_t n = a->n;
+#pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < n; k++) {
+        float g = grads[k];
+        m[k] = b1 * m[k] + (1.0f - b1) * g;
+        v[k] = b2 * v[k] + (1.0f - b2) * g * g;
+        params[k] -= step * m[k] / (sqrtf(v[k]) / sbc2 + eps);
+    }
+}
+
+double tcb_atlas_lr_at(double lr0, long long it, long long total)
+{
+    double lr = lr0;
+    if (it >= total * 8 / 10) lr *= 0.1;
+    if (it >= total * 9 / 10) lr *= 0.1;
+    return lr;
+}

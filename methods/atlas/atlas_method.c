@@ -1,0 +1,286 @@
+/* atlasnet, dsr and mca: one network and training loop (model.h,
+ * train.h), three method tables that differ only in the loss.
+ *
+ * Presets (overridable key by key; the default is cpu):
+ *   paper  C 1024, P 10, M 2500, 200,000 iterations (reference-protocol §4)
+ *   cpu    C 256,  P 10, M 1000,  20,000 iterations (sized for 2 CPU cores)
+ *   tiny   C 32,   P 4,  M 200,      300 iterations (tests)
+ *
+ * The checkpoint (save/load) holds the trained weights only: it is written
+ * after fit, so there is no Adam state or iteration to resume. */
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "methods/atlas/eval.h"
+#include "methods/atlas/train.h"
+#include "methods/builtin.h"
+#include "methods/params.h"
+#include "tcb/fsutil.h"
+#include "tcb/json.h"
+#include "tcb/metrics.h"
+
+typedef struct atlas_preset {
+    int C, P, M;
+    long long iterations;
+} atlas_preset;
+
+static const atlas_preset presets[] = {
+    {1024, 10, 2500, 200000},
+    {256, 10, 1000, 20000},
+    {32, 4, 200, 300},
+};
+static const char *const preset_names[] = {"paper", "cpu", "tiny", NULL}; /* presets[k]; default cpu */
+
+typedef struct atlas_method {
+    const char *name;           /* the method's, for messages */
+    int C, P;
+    tcb_atlas_train_cfg cfg;
+    uint64_t seed;              /* of the fit: the UV cache's stream */
+    tcb_atlas_model *model;     /* NULL before fit or load */
+    tcb_atlas_uv_cache uvc;
+    const tcb_sequence *last_seq; /* the last pair evaluated: (last_seq, last_i, last_j) */
+    int last_i, last_j, n_pred;
+    float *pred;                /* [2][n_pred][3] its predictions of frames i and j */
+} atlas_method;
+
+static int parse(const char *params_json, const char *where, atlas_method *a, tcb_error *err)
+{
+    static const char *const keys[] = {"preset", "iterations", "latent", "patches", "uv_samples",
+                                       "alpha_mc", "alpha_sciso", "delta", "lr", NULL};
+    cJSON *j;
+    int rc = tcb_params_parse(params_json, where, keys, &j, err);
+    if (rc) return rc;
+    int pi = 0;
+    long long it = 0, C = 0, P = 0, M = 0, delta = 0;
+    tcb_atlas_train_cfg *c = &a->cfg;
+    rc = tcb_json_enum(j, "preset", where, 0, 1, preset_names, &pi, err);
+    const atlas_preset *pr = &presets[pi];
+    if (!rc) rc = tcb_json_int(j, "iterations", where, 0, pr->iterations, 1, 100000000, &it, err);
+    if (!rc) rc = tcb_json_int(j, "latent", where, 0, pr->C, 1, 65536, &C, err);
+    if (!rc) rc = tcb_json_int(j, "patches", where, 0, pr->P, 1, 1000, &P, err);
+    if (!rc) rc = tcb_json_int(j, "uv_samples", where, 0, pr->M, 1, 10000000, &M, err);
+    if (!rc) rc = tcb_json_num(j, "alpha_mc", where, 0, 0.1, 0, 1e6, &c->alpha_mc, err);
+    if (!rc) rc = tcb_json_num(j, "alpha_sciso", where, 0, 0.001, 0, 1e6, &c->alpha_sciso, err);
+    if (!rc) rc = tcb_json_int(j, "delta", where, 0, 1, 1, 1000000, &delta, err);
+    if (!rc) rc = tcb_json_num(j, "lr", where, 0, 1e-3, 1e-12, 10, &c->lr, err);
+    cJSON_Delete(j);
+    if (rc) return rc;
+    if (M % P)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: uv_samples %lld must be a multiple of patches %lld", where, M,
+                        P);
+    a->C = (int)C, a->P = (int)P;
+    c->M = (int)M, c->iterations = it, c->delta = (int)delta;
+    return TCB_OK;
+}
+
+static int create(const char *name, tcb_atlas_loss loss, const char *params_json, void **self,
+                  tcb_error *err)
+{
+    *self = NULL;
+    char where[64];
+    snprintf(where, sizeof where, "%s.params", name);
+    atlas_method *a = calloc(1, sizeof *a);
+    if (!a) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", name);
+    a->name = name, a->cfg.loss = loss, a->last_i = a->last_j = -1;
+    int rc = parse(params_json, where, a, err);
+    if (rc) {
+        free(a);
+        return rc;
+    }
+    *self = a;
+    return TCB_OK;
+}
+
+static void forget_pair(atlas_method *a)
+{
+    free(a->pred);
+    a->pred = NULL, a->n_pred = 0, a->last_seq = NULL, a->last_i = a->last_j = -1;
+}
+
+/* A fresh model initialised from (seed, "atlas/init"). */
+static int new_model(atlas_method *a, uint64_t seed, tcb_error *err)
+{
+    tcb_atlas_model_free(a->model);
+    a->model = NULL;
+    forget_pair(a);
+    tcb_atlas_uv_cache_free(&a->uvc);
+    tcb_atlas_uv_cache_init(&a->uvc, seed);
+    a->seed = seed;
+    int rc = tcb_atlas_model_create(a->C, a->P, &a->model, err);
+    if (rc) return rc;
+    tcb_rng rng;
+    tcb_rng_seed_stream(&rng, seed, "atlas/init");
+    tcb_atlas_model_init(a->model, &rng);
+    return TCB_OK;
+}
+
+static int train(atlas_method *a, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_error *err)
+{
+    tcb_atlas_trainer *t = NULL;
+    int rc = new_model(a, ctx->seed, err);
+    if (!rc) rc = tcb_atlas_trainer_create(&a->cfg, a->model, seq, ctx->seed, &t, err);
+    long long total = a->cfg.iterations;
+    for (long long it = 0; !rc && it < total; it++) {
+        double loss;
+        rc = tcb_atlas_train_step(t, seq, &loss, err);
+        if (!rc && ((it + 1) % 10 == 0 || it + 1 == total))
+            tcb_report_progress(&ctx->reporter, (double)(it + 1), (double)total, a->name);
+        if (!rc && ((it + 1) % 1000 == 0 || it + 1 == total))
+            tcb_report_log(&ctx->reporter, TCB_LOG_DEBUG, "%s: iteration %lld loss %.6g", a->name, it + 1, loss);
+    }
+    tcb_atlas_trainer_free(t);
+    if (rc) tcb_error_prefix(err, "%s: ", a->name);
+    return rc;
+}
+
+/* Training uses ctx->n_threads OpenMP threads (OpenBLAS's OpenMP build
+ * follows them); the caller's setting is restored afterwards. The
+ * evaluation runs with the process's setting, as it gets no ctx. */
+static int fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_error *err)
+{
+    int prev_threads = omp_get_max_threads();
+    if (ctx->n_threads > 0) omp_set_num_threads(ctx->n_threads);
+    int rc = train(self, seq, ctx, err);
+    omp_set_num_threads(prev_threads);
+    return rc;
+}
+
+/* Evaluates pair (i, j) with fresh input clouds from rng, unless it is the
+ * pair evaluated last. */
+static int eval_pair(atlas_method *a, const tcb_sequence *seq, int i, int j, tcb_rng *rng,
+                     tcb_error *err)
+{
+    if (!a->model) return tcb_fail(err, TCB_ERR_INTERNAL, "%s: evaluation before fit or load", a->name);
+    if (i < 0 || j < 0 || i >= seq->n_frames || j >= seq->n_frames || seq->pool_size < 1 || seq->input_points < 1)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: pair %d->%d outside frames 0..%d or no point pools", a->name, i,
+                        j, seq->n_frames - 1);
+    if (a->pred && a->last_seq == seq && a->last_i == i && a->last_j == j) return TCB_OK;
+    forget_pair(a);
+    int N = seq->input_points;
+    float *clouds = malloc((size_t)2 * N * 3 * sizeof *clouds);
+    if (!clouds) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", a->name);
+    int rc = tcb_sequence_draw_points(seq, i, N, seq->draw_with_replacement, rng, clouds, err);
+    if (!rc) rc = tcb_sequence_draw_points(seq, j, N, seq->draw_with_replacement, rng, clouds + (size_t)N * 3, err);
+    if (!rc) rc = tcb_atlas_eval_pair(a->model, &a->uvc, clouds, N, &a->pred, &a->n_pred, err);
+    free(clouds);
+    if (!rc) a->last_seq = seq, a->last_i = i, a->last_j = j;
+    return rc;
+}
+
+static int transfer(void *self, const tcb_sequence *seq, int i, int j, const float *src, int n, float *out,
+                    tcb_rng *rng, tcb_error *err)
+{
+    atlas_method *a = self;
+    int rc = eval_pair(a, seq, i, j, rng, err);
+    if (rc) return rc;
+    return tcb_atlas_transfer(src, n, a->pred, a->pred + (size_t)a->n_pred * 3, a->n_pred, out, err);
+}
+
+static int reconstruct(void *self, const tcb_sequence *seq, int i, int j, int frame, tcb_rng *rng, float **pts,
+                       int *n, tcb_error *err)
+{
+    atlas_method *a = self;
+    *pts = NULL, *n = 0;
+    if (frame != i && frame != j)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: frame %d is not in pair %d->%d", a->name, frame, i, j);
+    int rc = eval_pair(a, seq, i, j, rng, err);
+    if (rc) return rc;
+    size_t len = (size_t)a->n_pred * 3 * sizeof **pts;
+    *pts = malloc(len);
+    if (!*pts) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", a->name);
+    memcpy(*pts, a->pred + (frame == i ? 0 : (size_t)a->n_pred * 3), len);
+    *n = a->n_pred;
+    return TCB_OK;
+}
+
+static void destroy(void *self)
+{
+    atlas_method *a = self;
+    if (!a) return;
+    tcb_atlas_model_free(a->model);
+    tcb_atlas_uv_cache_free(&a->uvc);
+    free(a->pred);
+    free(a);
+}
+
+/* ---- checkpoint -----------------------------------------------------------
+ * One file (the harness publishes a single path), host byte order:
+ *     char   magic[8]   "TCBATLS1"
+ *     uint64 seed       of the fit (the evaluation's UV sets derive from it)
+ *     uint64 mlen       then the model manifest (model.h), mlen bytes
+ *     float  params[]   the rest: the model's export
+ * The model's own export/import writes and checks the two parts, so they go
+ * through side files next to the checkpoint. */
+#define MAGIC "TCBATLS1"
+#define HDR 24
+
+static int side_paths(const char *path, char *bin, char *man, tcb_error *err)
+{
+    int rc = tcb_path_join(bin, TCB_PATH_MAX, err, "%s.weights", path);
+    if (!rc) rc = tcb_path_join(man, TCB_PATH_MAX, err, "%s.manifest.json", path);
+    return rc;
+}
+
+static int save(void *self, const char *path, tcb_error *err)
+{
+    atlas_method *a = self;
+    if (!a->model) return tcb_fail(err, TCB_ERR_INTERNAL, "%s: %s saved before fit", path, a->name);
+    char bin[TCB_PATH_MAX], man[TCB_PATH_MAX];
+    char *wb = NULL, *mb = NULL, *buf = NULL;
+    size_t wl = 0, ml = 0;
+    int rc = side_paths(path, bin, man, err);
+    if (!rc) rc = tcb_atlas_model_export(a->model, bin, man, err);
+    if (!rc) rc = tcb_read_file(bin, &wb, &wl, err);
+    if (!rc) rc = tcb_read_file(man, &mb, &ml, err);
+    if (!rc && !(buf = malloc(HDR + ml + wl))) rc = tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", path);
+    if (!rc) {
+        uint64_t mlen = ml;
+        memcpy(buf, MAGIC, 8), memcpy(buf + 8, &a->seed, 8), memcpy(buf + 16, &mlen, 8);
+        memcpy(buf + HDR, mb, ml), memcpy(buf + HDR + ml, wb, wl);
+        rc = tcb_write_file_atomic(path, buf, HDR + ml + wl, err);
+    }
+    remove(bin), remove(man);
+    free(wb), free(mb), free(buf);
+    return rc;
+}
+
+static int load(void *self, const tcb_sequence *seq, const char *path, tcb_error *err)
+{
+    (void)seq; /* the weights do not depend on which sequence is evaluated */
+    atlas_method *a = self;
+    char bin[TCB_PATH_MAX], man[TCB_PATH_MAX], *buf = NULL;
+    size_t len = 0;
+    uint64_t seed = 0, mlen = 0;
+    int rc = side_paths(path, bin, man, err);
+    if (!rc) rc = tcb_read_file(path, &buf, &len, err);
+    if (!rc && len >= HDR) memcpy(&seed, buf + 8, 8), memcpy(&mlen, buf + 16, 8);
+    if (!rc && (len < HDR || memcmp(buf, MAGIC, 8) || mlen > len - HDR))
+        rc = tcb_fail(err, TCB_ERR_INPUT, "%s: not an atlas checkpoint (bad magic or length)", path);
+    if (!rc) rc = tcb_write_file_atomic(man, buf + HDR, mlen, err);
+    if (!rc) rc = tcb_write_file_atomic(bin, buf + HDR + mlen, len - HDR - mlen, err);
+    if (!rc) rc = new_model(a, seed, err);
+    if (!rc) rc = tcb_atlas_model_import(a->model, bin, man, err);
+    if (rc && a->model) tcb_atlas_model_free(a->model), a->model = NULL;
+    remove(bin), remove(man);
+    free(buf);
+    return rc;
+}
+
+/* ---- the three tables ---------------------------------------------------- */
+
+#define ATLAS_METHOD(id, loss, desc)                                                                         \
+    static int id##_create(const char *params_json, void **self, tcb_error *err)                             \
+    {                                                                                                        \
+        return create(#id, loss, params_json, self, err);                                                    \
+    }                                                                                                        \
+    const tcb_method_ops tcb_method_##id = {                                                                 \
+        .abi_version = TCB_METHOD_ABI_VERSION, .name = #id, .description = desc, .create = id##_create,      \
+        .fit = fit, .transfer = transfer, .reconstruct = reconstruct, .save = save, .load = load,            \
+        .destroy = destroy,                                                                                  \
+    };
+
+ATLAS_METHOD(atlasnet, TCB_ATLAS_LOSS_CHAMFER, "AtlasNet: PointNet + patch decoders, Chamfer loss only")
+ATLAS_METHOD(dsr, TCB_ATLAS_LOSS_DSR, "DSR: AtlasNet + scaled-isometry and total-area terms (alpha_sciso 0.001)")
+ATLAS_METHOD(mca, TCB_ATLAS_LOSS_METRIC, "MCA: AtlasNet + metric consistency between neighbour frames (alpha_mc 0.1)")
