@@ -26,6 +26,22 @@ typedef struct run_state {
     tcb_run_stats *stats;
 } run_state;
 
+/* Unlinks the regular files in `dir` whose names start with `prefix` and
+ * contain `infix` ("" matches anything). */
+static void remove_files(const char *dir, const char *prefix, const char *infix)
+{
+    DIR *d = opendir(dir);
+    if (!d) return;
+    for (struct dirent *e; (e = readdir(d));) {
+        char victim[TCB_PATH_MAX];
+        if (strncmp(e->d_name, prefix, strlen(prefix)) != 0 || !strstr(e->d_name, infix)) continue;
+        if ((size_t)snprintf(victim, sizeof victim, "%s/%s", dir, e->d_name) < sizeof victim &&
+            tcb_is_file(victim))
+            remove(victim);
+    }
+    closedir(d);
+}
+
 /* Unlinks "<path>.tmp-*" left by a writer killed before its rename: a
  * resumed run must not leave debris that a finished run would not have. */
 static void remove_stale_temps(const char *path)
@@ -36,17 +52,17 @@ static void remove_stale_temps(const char *path)
     const char *base = slash ? slash + 1 : path;
     if (slash) *slash = '\0';
     char prefix[TCB_PATH_MAX];
-    snprintf(prefix, sizeof prefix, "%s.tmp-", base);
-    DIR *d = opendir(slash ? dir : ".");
-    if (!d) return;
-    for (struct dirent *e; (e = readdir(d));) {
-        char victim[TCB_PATH_MAX];
-        if (strncmp(e->d_name, prefix, strlen(prefix)) != 0) continue;
-        if ((size_t)snprintf(victim, sizeof victim, "%s/%s", slash ? dir : ".", e->d_name) <
-            sizeof victim)
-            remove(victim);
-    }
-    closedir(d);
+    if ((size_t)snprintf(prefix, sizeof prefix, "%s.tmp-", base) >= sizeof prefix) return;
+    remove_files(slash ? dir : ".", prefix, "");
+}
+
+/* A cell's work directory holds only its method's checkpoints (the model
+ * after fit, a training in progress). --force starts the cell from nothing,
+ * so it empties the directory; otherwise only killed writers' temporaries
+ * go. */
+static void prepare_work_dir(const char *work, int force)
+{
+    remove_files(work, "", force ? "" : ".tmp-");
 }
 
 static int load_plugins(const tcb_config *cfg, tcb_error *err)
@@ -210,7 +226,7 @@ static int run_cell(const run_state *st, const seq_ctx *sc, const tcb_method_spe
     if (!rc) rc = tcb_path_join(ckpt, sizeof ckpt, err, "%s/model.ckpt", work);
     if (!rc) rc = tcb_mkdirs(work, err);
     if (rc) return rc;
-    remove_stale_temps(ckpt);
+    prepare_work_dir(work, st->opts->force);
     remove_stale_temps(cell_path);
     tcb_cell_job job = {
         .seq = sc->seq,

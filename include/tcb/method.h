@@ -42,7 +42,9 @@ extern "C" {
 typedef struct tcb_fit_ctx {
     uint64_t seed;          /* the cell's seed */
     int n_threads;          /* threads the method may use */
-    const char *work_dir;   /* per-cell directory for checkpoints; exists */
+    const char *work_dir;   /* per-cell directory for checkpoints; exists. A fit may
+                             * keep its training state there to resume a killed
+                             * run; --force empties it first */
     tcb_reporter reporter;  /* progress bar and log */
 } tcb_fit_ctx;
 

@@ -6,8 +6,11 @@
  *   cpu    C 256,  P 10, M 1000,  20,000 iterations (sized for 2 CPU cores)
  *   tiny   C 32,   P 4,  M 200,      300 iterations (tests)
  *
- * The checkpoint (save/load) holds the trained weights only: it is written
- * after fit, so there is no Adam state or iteration to resume. */
+ * Two kinds of checkpoint. During fit, every `checkpoint_every` iterations
+ * the whole training state goes to <work_dir>/train.ckpt (train_ckpt.h); a
+ * fit that finds one continues from it, bit-identical to an uninterrupted
+ * training, and deletes it when done. After fit the harness saves the
+ * trained weights through save/load below. */
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,6 +18,7 @@
 
 #include "methods/atlas/eval.h"
 #include "methods/atlas/train.h"
+#include "methods/atlas/train_ckpt.h"
 #include "methods/builtin.h"
 #include "methods/params.h"
 #include "tcb/fsutil.h"
@@ -37,6 +41,7 @@ typedef struct atlas_method {
     const char *name;           /* the method's, for messages */
     int C, P;
     tcb_atlas_train_cfg cfg;
+    long long checkpoint_every; /* iterations between training checkpoints; 0: none */
     uint64_t seed;              /* of the fit: the UV cache's stream */
     tcb_atlas_model *model;     /* NULL before fit or load */
     tcb_atlas_uv_cache uvc;
@@ -48,7 +53,8 @@ typedef struct atlas_method {
 static int parse(const char *params_json, const char *where, atlas_method *a, tcb_error *err)
 {
     static const char *const keys[] = {"preset", "iterations", "latent", "patches", "uv_samples",
-                                       "alpha_mc", "alpha_sciso", "delta", "lr", NULL};
+                                       "alpha_mc", "alpha_sciso", "delta", "lr", "checkpoint_every",
+                                       "divergence", NULL};
     cJSON *j;
     int rc = tcb_params_parse(params_json, where, keys, &j, err);
     if (rc) return rc;
@@ -65,6 +71,8 @@ static int parse(const char *params_json, const char *where, atlas_method *a, tc
     if (!rc) rc = tcb_json_num(j, "alpha_sciso", where, 0, 0.001, 0, 1e6, &c->alpha_sciso, err);
     if (!rc) rc = tcb_json_int(j, "delta", where, 0, 1, 1, 1000000, &delta, err);
     if (!rc) rc = tcb_json_num(j, "lr", where, 0, 1e-3, 1e-12, 10, &c->lr, err);
+    if (!rc) rc = tcb_json_int(j, "checkpoint_every", where, 0, 1000, 0, 100000000, &a->checkpoint_every, err);
+    if (!rc) rc = tcb_json_num(j, "divergence", where, 0, 1e4, 0, 1e300, &c->divergence, err);
     cJSON_Delete(j);
     if (rc) return rc;
     if (M % P)
@@ -116,21 +124,45 @@ static int new_model(atlas_method *a, uint64_t seed, tcb_error *err)
     return TCB_OK;
 }
 
+/* Continues from <work_dir>/train.ckpt when there is one. A checkpoint that
+ * cannot be continued (corrupt, other settings) is reported and ignored:
+ * training starts over, as the harness does with a bad model checkpoint. */
+static void resume(atlas_method *a, tcb_atlas_trainer *t, const tcb_sequence *seq, const tcb_fit_ctx *ctx,
+                   const char *path)
+{
+    if (!path[0] || !tcb_is_file(path)) return;
+    tcb_error e = {0};
+    if (tcb_atlas_train_ckpt_load(t, seq, ctx->seed, path, &e) == TCB_OK)
+        tcb_report_log(&ctx->reporter, TCB_LOG_INFO, "%s: resuming training at iteration %lld from %s", a->name,
+                       t->it, path);
+    else
+        tcb_report_log(&ctx->reporter, TCB_LOG_WARN, "%s: not resumed (%s); training from the start", a->name,
+                       e.msg);
+}
+
 static int train(atlas_method *a, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_error *err)
 {
     tcb_atlas_trainer *t = NULL;
+    char ckpt[TCB_PATH_MAX] = "";
     int rc = new_model(a, ctx->seed, err);
+    if (!rc && ctx->work_dir && a->checkpoint_every > 0)
+        rc = tcb_path_join(ckpt, sizeof ckpt, err, "%s/%s", ctx->work_dir, TCB_ATLAS_TRAIN_CKPT);
     if (!rc) rc = tcb_atlas_trainer_create(&a->cfg, a->model, seq, ctx->seed, &t, err);
+    if (!rc) resume(a, t, seq, ctx, ckpt);
     long long total = a->cfg.iterations;
-    for (long long it = 0; !rc && it < total; it++) {
+    while (!rc && t->it < total) {
         double loss;
         rc = tcb_atlas_train_step(t, seq, &loss, err);
-        if (!rc && ((it + 1) % 10 == 0 || it + 1 == total))
-            tcb_report_progress(&ctx->reporter, (double)(it + 1), (double)total, a->name);
-        if (!rc && ((it + 1) % 1000 == 0 || it + 1 == total))
-            tcb_report_log(&ctx->reporter, TCB_LOG_DEBUG, "%s: iteration %lld loss %.6g", a->name, it + 1, loss);
+        long long done = t->it;
+        if (!rc && (done % 10 == 0 || done == total))
+            tcb_report_progress(&ctx->reporter, (double)done, (double)total, a->name);
+        if (!rc && (done % 1000 == 0 || done == total))
+            tcb_report_log(&ctx->reporter, TCB_LOG_DEBUG, "%s: iteration %lld loss %.6g", a->name, done, loss);
+        if (!rc && ckpt[0] && done % a->checkpoint_every == 0 && done < total)
+            rc = tcb_atlas_train_ckpt_save(t, seq, ctx->seed, ckpt, err);
     }
     tcb_atlas_trainer_free(t);
+    if (!rc && ckpt[0]) remove(ckpt); /* the harness's model checkpoint supersedes it */
     if (rc) tcb_error_prefix(err, "%s: ", a->name);
     return rc;
 }

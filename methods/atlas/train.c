@@ -21,10 +21,11 @@ int tcb_atlas_trainer_create(const tcb_atlas_train_cfg *cfg, tcb_atlas_model *mo
                         "atlas: sequence %s needs at least 2 frames, point pools and input_points > 0 "
                         "(has %d frames, pool %d, input_points %d)",
                         seq->name, seq->n_frames, seq->pool_size, seq->input_points);
-    if (cfg->M < model->P || cfg->M % model->P || cfg->delta < 1 || cfg->iterations < 1)
+    if (cfg->M < model->P || cfg->M % model->P || cfg->delta < 1 || cfg->iterations < 1 || cfg->divergence < 0)
         return tcb_fail(err, TCB_ERR_INPUT,
                         "atlas: uv_samples %d must be a positive multiple of patches %d, delta %d ≥ 1, "
-                        "iterations %lld ≥ 1", cfg->M, model->P, cfg->delta, cfg->iterations);
+                        "iterations %lld ≥ 1, divergence %g ≥ 0", cfg->M, model->P, cfg->delta, cfg->iterations,
+                        cfg->divergence);
     tcb_atlas_trainer *t = calloc(1, sizeof *t);
     if (!t) return tcb_fail(err, TCB_ERR_NOMEM, "atlas: out of memory");
     t->cfg = *cfg, t->model = model, t->N = seq->input_points;
@@ -126,6 +127,10 @@ int tcb_atlas_train_step(tcb_atlas_trainer *t, const tcb_sequence *seq, double *
     }
     if (!rc && !grads_finite(t->model))
         rc = tcb_fail(err, TCB_ERR_NUMERIC, "atlas: non-finite gradient");
+    if (!rc && t->it == 0) t->loss0 = *loss;
+    if (!rc && t->cfg.divergence > 0 && *loss > t->cfg.divergence * t->loss0)
+        rc = tcb_fail(err, TCB_ERR_NUMERIC, "atlas: diverged, loss %g > %g x the first iteration's %g", *loss,
+                      t->cfg.divergence, t->loss0);
     if (rc) {
         tcb_error_prefix(err, "iteration %lld: ", t->it);
         return rc;

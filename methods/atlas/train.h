@@ -25,6 +25,7 @@ typedef struct tcb_atlas_train_cfg {
     long long iterations;   /* total, for the lr schedule */
     double lr, alpha_mc, alpha_sciso;
     int delta;              /* neighbour pairs: 1 ≤ |a − b| ≤ delta */
+    double divergence;      /* a loss above divergence × the first one stops training */
 } tcb_atlas_train_cfg;
 
 #define TCB_ATLAS_BATCH 4 /* two pairs */
@@ -36,6 +37,7 @@ typedef struct tcb_atlas_trainer {
     tcb_atlas_adam adam;
     tcb_rng rng;            /* pairs, clouds and UV samples */
     long long it;           /* iterations done */
+    double loss0;           /* the loss of iteration 0 */
     int N;                  /* input points per cloud */
     int frames[TCB_ATLAS_BATCH];
     double area[TCB_ATLAS_BATCH];
@@ -54,8 +56,10 @@ int tcb_atlas_trainer_create(const tcb_atlas_train_cfg *cfg, tcb_atlas_model *mo
 void tcb_atlas_trainer_free(tcb_atlas_trainer *t);
 
 /* Iteration t->it: *loss gets the total loss before the update. A
- * non-finite loss or gradient is TCB_ERR_NUMERIC naming the iteration; the
- * parameters are then left as they were before the step. */
+ * non-finite loss or gradient, or a loss above cfg.divergence × the first
+ * iteration's, is TCB_ERR_NUMERIC naming the iteration (the harness records
+ * the cell as diverged); the parameters are then left as they were before
+ * the step. */
 int tcb_atlas_train_step(tcb_atlas_trainer *t, const tcb_sequence *seq, double *loss,
                          tcb_error *err);
 

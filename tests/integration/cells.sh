@@ -1,0 +1,22 @@
+# Sourced by the integration tests that compare runs cell by cell.
+
+# same_cells A B: the same cell files with the same contents, but for the
+# fields that measure the machine rather than the method.
+same_cells() {
+    /usr/bin/python3 - "$1" "$2" <<'PY'
+import json, os, sys
+def cells(root):
+    out = {}
+    for d, _, files in os.walk(os.path.join(root, "cells")):
+        for f in files:
+            c = json.load(open(os.path.join(d, f)))
+            c.pop("timings"); c.pop("peak_rss_kb")
+            out[os.path.relpath(os.path.join(d, f), root)] = c
+    return out
+a, b = cells(sys.argv[1]), cells(sys.argv[2])
+assert sorted(a) == sorted(b), (sorted(a), sorted(b))
+for k in a:
+    assert a[k] == b[k], "cell %s differs" % k
+print("%d cells identical" % len(a))
+PY
+}

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# A training killed (SIGKILL) after its first checkpoint resumes from it and
+# ends with the same cell as an uninterrupted run; no training state or
+# temporary is left; --force starts from scratch (a stale training state in
+# the cell's work directory is not even looked at).
+set -euo pipefail
+: "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
+source "$TCB_SOURCE_DIR/tests/integration/cells.sh"
+
+tmp=$(mktemp -d)
+pid=""
+trap '[ -n "$pid" ] && kill -9 "$pid" 2>/dev/null; rm -rf "$tmp"' EXIT
+cd "$tmp"
+
+cat > train.json <<'JSON'
+{ "name": "train", "splits_dir": "splits", "cache_dir": "", "seeds": [0], "threads": 1,
+  "evaluation": { "pairs": 4, "pool_size": 1000, "input_points": 300 },
+  "datasets": [ { "name": "synth", "source": "synthetic", "frames": 6,
+                  "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
+  "methods": [ { "name": "mca", "params": { "preset": "tiny", "iterations": 400, "checkpoint_every": 40 } } ] }
+JSON
+work=work/synth/quadruped_walk/mca/seed_0
+
+"$TCBENCH" run train.json --out full --quiet
+[ ! -e "full/$work/train.ckpt" ] || { echo "FAIL: training state left after a finished fit"; exit 1; }
+
+"$TCBENCH" run train.json --out killed --quiet &
+pid=$!
+for _ in $(seq 3000); do
+    [ -s "killed/$work/train.ckpt" ] && break
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.02
+done
+kill -9 "$pid" 2>/dev/null || true
+wait "$pid" 2>/dev/null || true
+pid=""
+[ -s "killed/$work/train.ckpt" ] && [ ! -e killed/cells/synth/quadruped_walk/mca/seed_0.json ] ||
+    { echo "FAIL: the kill did not land between the first checkpoint and the end"; exit 1; }
+
+"$TCBENCH" run train.json --out killed 2> resume.log
+grep -q "resuming training at iteration [1-9]" resume.log || { echo "FAIL: did not resume"; cat resume.log; exit 1; }
+same_cells full killed
+leftovers=$(find killed -name '*.tmp-*' -o -name train.ckpt)
+[ -z "$leftovers" ] || { echo "FAIL: left behind: $leftovers"; exit 1; }
+
+echo "not a checkpoint" > "killed/$work/train.ckpt"
+"$TCBENCH" run train.json --out killed --force 2> force.log
+if grep -q "not resumed" force.log; then echo "FAIL: --force looked at the old training state"; cat force.log; exit 1; fi
+same_cells full killed
+echo "atlas training resume test passed"
