@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Install the Debian packages tcbench needs, if any are missing. Safe to rerun:
 # it only calls apt-get when something is absent.
+#   scripts/setup.sh           what building and running tcbench needs
+#   scripts/setup.sh --tests   also the references the test suite compares
+#                              against (PyTorch for the atlas cross-checks)
 set -euo pipefail
 
 packages=(
@@ -13,6 +16,11 @@ packages=(
   libcmocka-dev                           # unit-test framework
   python3 python3-numpy python3-scipy     # tests: JSON comparisons, scipy reference for linear assignment
 )
+if [ "${1:-}" = "--tests" ]; then
+  packages+=(python3-torch)               # the atlas network and training step against PyTorch
+elif [ $# -gt 0 ]; then
+  echo "usage: scripts/setup.sh [--tests]" >&2; exit 2
+fi
 
 missing=()
 for p in "${packages[@]}"; do

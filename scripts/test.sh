@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-scripts/setup.sh
+scripts/setup.sh --tests
 cmake -S . -B build-test -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTCB_SANITIZE=ON >/dev/null
 cmake --build build-test -j"$(nproc)" >/dev/null
 cd build-test
