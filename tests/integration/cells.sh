@@ -1,4 +1,5 @@
-# Sourced by the integration tests that compare runs cell by cell.
+# Sourced by the integration tests that interrupt runs and compare them cell
+# by cell.
 
 # same_cells A B: the same cell files with the same contents, but for the
 # fields that measure the machine rather than the method.
@@ -19,4 +20,18 @@ for k in a:
     assert a[k] == b[k], "cell %s differs" % k
 print("%d cells identical" % len(a))
 PY
+}
+
+# kill_when PID COMMAND...: SIGKILL the run PID as soon as COMMAND succeeds
+# (polling for up to a minute), or let it be once it has exited.
+kill_when() {
+    local pid=$1
+    shift
+    for _ in $(seq 3000); do
+        "$@" && break
+        kill -0 "$pid" 2>/dev/null || break
+        sleep 0.02
+    done
+    kill -9 "$pid" 2>/dev/null || true
+    wait "$pid" 2>/dev/null || true
 }

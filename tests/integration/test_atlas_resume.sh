@@ -26,13 +26,7 @@ work=work/synth/quadruped_walk/mca/seed_0
 
 "$TCBENCH" run train.json --out killed --quiet &
 pid=$!
-for _ in $(seq 3000); do
-    [ -s "killed/$work/train.ckpt" ] && break
-    kill -0 "$pid" 2>/dev/null || break
-    sleep 0.02
-done
-kill -9 "$pid" 2>/dev/null || true
-wait "$pid" 2>/dev/null || true
+kill_when "$pid" test -s "killed/$work/train.ckpt"
 pid=""
 [ -s "killed/$work/train.ckpt" ] && [ ! -e killed/cells/synth/quadruped_walk/mca/seed_0.json ] ||
     { echo "FAIL: the kill did not land between the first checkpoint and the end"; exit 1; }

@@ -34,13 +34,8 @@ count_cells() { find "$1/cells" -name 'seed_*.json' 2>/dev/null | wc -l; }
 # Kill a second run once a few cells are done, then resume it.
 "$TCBENCH" run grid.json --out killed --quiet 2> killed.log &
 pid=$!
-for _ in $(seq 600); do
-    [ "$(count_cells killed)" -ge 3 ] && break
-    kill -0 "$pid" 2>/dev/null || break
-    sleep 0.05
-done
-kill -9 "$pid" 2>/dev/null || true
-wait "$pid" 2>/dev/null || true
+three_done() { [ "$(count_cells killed)" -ge 3 ]; }
+kill_when "$pid" three_done
 pid=""
 done_at_kill=$(count_cells killed)
 if [ "$done_at_kill" -lt 3 ] || [ "$done_at_kill" -ge $n_cells ]; then
