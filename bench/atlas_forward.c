@@ -3,12 +3,8 @@
  * tangents (MCA, DSR: the loss needs φ_u, φ_v) and without (AtlasNet: CD
  * only, a third of the decoder work).
  *
- * FLOPs are the minimal count, 2 per multiply-add of the layers' products:
- * the stacked (1 + nt)·B·m-row GEMMs of each decoder, layer 1 split into its
- * once-per-(shape, patch) z part and its rank-2 uv part, the encoder; a
- * backward layer counts its weight and input gradients, conv3's only at the
- * max-pool's winning points. Elementwise work (softplus, ReLU, bias) is not
- * counted. Best of `reps` runs.
+ * FLOPs are the minimal count of atlas_bench.h (2 per multiply-add of the
+ * layers' products; elementwise work not counted). Best of `reps` runs.
  *
  * Measured on the 2-core AMD EPYC dev machine (quiet, 2 threads, best of 5;
  * fp32 peak ≈ 230 GFLOP/s, OpenBLAS sgemm 190–200 on these shapes):
@@ -24,38 +20,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
+#include "atlas_bench.h"
 #include "methods/atlas/model.h"
 
 typedef struct {
     const char *name;
     int C, P, M, B, N;
 } scale;
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
-/* Multiply-adds of the forward (fwd) and backward (bwd) passes. */
-static void count_macs(const scale *s, int nt, double *fwd, double *bwd)
-{
-    double B = s->B, pts = (double)s->B * s->N, C = s->C;
-    double h1 = C + 2, h2 = (s->C + 2) / 2, h3 = (s->C + 2) / 4;
-    double rows = (1.0 + nt) * B * (s->M / s->P), vals = B * (s->M / s->P);
-    double enc = pts * (3 * 64 + 64 * 128 + 128 * C) + B * 2 * C * C;
-    double dec = B * C * h1 + vals * 2 * h1 + rows * (h1 * h2 + h2 * h3 + h3 * 3);
-    *fwd = enc + s->P * dec;
-    /* backward: conv1 has no input gradient; conv3's gradient reaches one
-     * point per (shape, channel) through the max-pool; layer 1's uv part is
-     * elementwise */
-    double enc_b = 2 * enc - pts * 3 * 64 - 2 * pts * 128 * C + 2 * B * C * 128;
-    double dec_b = 2 * B * C * h1 + vals * 2 * h1 + 2 * rows * (h1 * h2 + h2 * h3 + h3 * 3);
-    *bwd = enc_b + s->P * dec_b;
-}
 
 static void fill(float *x, size_t n, double lo, double hi, tcb_rng *r)
 {
@@ -85,21 +57,21 @@ static int run(const scale *s, int reps)
     for (int nt = 2; nt >= 0; nt -= 2) {
         double best_f = 1e300, best_b = 1e300, fm, bm;
         for (int r = 0; r < reps; r++) {
-            double t0 = now_ms();
+            double t0 = bench_now_ms();
             tcb_atlas_model_forward(m, w, clouds, uv, out, nt ? out + nout : NULL,
                                     nt ? out + 2 * nout : NULL);
-            double t1 = now_ms();
+            double t1 = bench_now_ms();
             tcb_atlas_model_zero_grad(m);
             if (tcb_atlas_model_backward(m, w, out + 3 * nout, nt ? out + 4 * nout : NULL,
                                          nt ? out + 5 * nout : NULL, &err)) {
                 fprintf(stderr, "bench_atlas_forward: %s\n", err.msg);
                 return 1;
             }
-            double t2 = now_ms();
+            double t2 = bench_now_ms();
             if (t1 - t0 < best_f) best_f = t1 - t0;
             if (t2 - t1 < best_b) best_b = t2 - t1;
         }
-        count_macs(s, nt, &fm, &bm);
+        bench_atlas_macs(s->C, s->P, s->M, s->B, s->N, nt, &fm, &bm);
         printf("%-6s C=%-4d P=%-2d M=%-4d B=%d N=%-4d %-11s fwd %8.1f ms %6.1f GF/s | "
                "bwd %8.1f ms %6.1f GF/s | step %8.1f ms %6.1f GF/s (%.1f GFLOP)\n",
                s->name, s->C, s->P, s->M, s->B, s->N, nt ? "tangents" : "no tangents", best_f,
@@ -114,14 +86,19 @@ static int run(const scale *s, int reps)
 
 int main(int argc, char **argv)
 {
-    int reps = argc > 1 ? atoi(argv[1]) : 3;
+    int reps = argc > 1 ? bench_positive_int(argv[1], "reps", "top of bench/atlas_forward.c") : 3;
     static const scale scales[] = {
         {"cpu", 256, 10, 1000, 4, 2500},
         {"paper", 1024, 10, 2500, 4, 2500},
     };
     printf("atlas network forward + backward, best of %d, %d thread(s)\n", reps,
            omp_get_max_threads());
-    for (size_t i = 0; i < sizeof scales / sizeof *scales; i++)
-        if ((argc < 3 || strcmp(argv[2], scales[i].name) == 0) && run(&scales[i], reps)) return 1;
-    return 0;
+    int matched = 0;
+    for (size_t i = 0; i < sizeof scales / sizeof *scales; i++) {
+        if (argc >= 3 && strcmp(argv[2], scales[i].name) != 0) continue;
+        matched++;
+        if (run(&scales[i], reps)) return 1;
+    }
+    if (!matched) fprintf(stderr, "bench_atlas_forward: no scale named '%s' (cpu, paper)\n", argv[2]);
+    return matched ? 0 : 2;
 }

@@ -11,21 +11,14 @@
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <time.h>
 
+#include "bench_util.h"
 #include "methods/atlas/loss_chamfer.h"
 #include "methods/atlas/loss_dsr.h"
 #include "methods/atlas/loss_metric.h"
 #include "methods/atlas/uv_regular.h"
 
 enum { B = 4, M = 2500, N = 2500, P = 10 };
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
 
 static void die(const tcb_error *err)
 {
@@ -46,7 +39,7 @@ static void sphere(tcb_rng *rng, float *p, int n, double sigma)
 
 int main(int argc, char **argv)
 {
-    int reps = argc > 1 ? atoi(argv[1]) : 10;
+    int reps = argc > 1 ? bench_positive_int(argv[1], "reps", "top of bench/atlas_loss.c") : 10;
     size_t np = (size_t)B * M * 3;
     float *pred = malloc(np * sizeof *pred), *target = malloc((size_t)B * N * 3 * sizeof *target);
     float *pu = malloc(np * sizeof *pu), *pv = malloc(np * sizeof *pv);
@@ -67,14 +60,14 @@ int main(int argc, char **argv)
     double best[3] = {1e300, 1e300, 1e300}, loss;
     tcb_error err = {0};
     for (int r = 0; r < reps; r++) {
-        double t0 = now_ms();
+        double t0 = bench_now_ms();
         if (tcb_atlas_chamfer_loss(pred, target, B, M, N, 1.0f, &loss, g0, &err)) die(&err);
-        double t1 = now_ms();
+        double t1 = bench_now_ms();
         if (tcb_atlas_metric_loss(pu, pv, B, M, 0.1f, &loss, g0, g1, &err)) die(&err);
-        double t2 = now_ms();
+        double t2 = bench_now_ms();
         if (tcb_atlas_dsr_loss(pu, pv, B, M, P, area_gt, &w, 1e-3f, &loss, NULL, g0, g1, &err))
             die(&err);
-        double t3 = now_ms();
+        double t3 = bench_now_ms();
         best[0] = fmin(best[0], t1 - t0);
         best[1] = fmin(best[1], t2 - t1);
         best[2] = fmin(best[2], t3 - t2);
@@ -87,9 +80,9 @@ int main(int argc, char **argv)
     printf("regular UV set (once per run and m), one run each\n");
     static const int sizes[] = {312, 347, 1041, 3125}; /* P' = 10, 9, 3, 1 */
     for (size_t s = 0; s < sizeof sizes / sizeof *sizes; s++) {
-        double t0 = now_ms();
+        double t0 = bench_now_ms();
         if (tcb_atlas_uv_regular(sizes[s], &rng, uv, &err)) die(&err);
-        printf("  m=%-5d %8.1f ms\n", sizes[s], now_ms() - t0);
+        printf("  m=%-5d %8.1f ms\n", sizes[s], bench_now_ms() - t0);
     }
     free(pred), free(target), free(pu), free(pv), free(g0), free(g1), free(uv);
     return 0;

@@ -17,18 +17,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
+#include "bench_util.h"
 #include "tcb/lap.h"
 #include "tcb/rng.h"
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
 
 static void die(const char *fmt, ...) __attribute__((format(printf, 1, 2), noreturn));
 
@@ -122,9 +115,9 @@ static double time_tcbench(const double *c, int n, int reps, int32_t *sol, doubl
     double best = 1e300;
     for (int r = 0; r < reps; r++) {
         tcb_error err = {0};
-        double t0 = now_ms();
+        double t0 = bench_now_ms();
         if (tcb_lap_solve(c, n, n, sol, total, &err)) die("%s", err.msg);
-        double t = now_ms() - t0;
+        double t = bench_now_ms() - t0;
         if (t < best) best = t;
     }
     return best;
@@ -141,16 +134,6 @@ static int time_scipy(const char *script, const char *path, int reps, double *ms
     if (!p) return -1;
     int ok = fscanf(p, "%lf %lf", ms, total) == 2;
     return pclose(p) == 0 && ok ? 0 : -1;
-}
-
-/* lap_scipy.py lives next to this file; __FILE__ is the absolute source path
- * CMake compiles from, which spares bench programs a configure-time define. */
-static void default_script(char *out, size_t size)
-{
-    snprintf(out, size, "%s", __FILE__);
-    char *slash = strrchr(out, '/');
-    size_t dir = slash ? (size_t)(slash + 1 - out) : 0;
-    snprintf(out + dir, size - dir, "lap_scipy.py");
 }
 
 static void bench(int *sizes, int nsizes, int reps, const char *script)
@@ -192,9 +175,9 @@ int main(int argc, char **argv)
     if (argc == 3 && strcmp(argv[1], "--solve") == 0) return solve_file(argv[2]);
     int reps = 1, nsizes = 0, sizes[32];
     char script[4096];
-    default_script(script, sizeof script);
+    bench_sibling_path(script, sizeof script, __FILE__, "lap_scipy.py");
     for (int a = 1; a < argc; a++) {
-        if (strcmp(argv[a], "--reps") == 0 && a + 1 < argc) reps = atoi(argv[++a]);
+        if (strcmp(argv[a], "--reps") == 0 && a + 1 < argc) reps = bench_positive_int(argv[++a], "--reps", "top of bench/lap.c");
         else if (strcmp(argv[a], "--scipy") == 0 && a + 1 < argc)
             snprintf(script, sizeof script, "%s", argv[++a]);
         else if (atoi(argv[a]) > 0 && nsizes < 32) sizes[nsizes++] = atoi(argv[a]);

@@ -8,17 +8,10 @@
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <time.h>
 
+#include "bench_util.h"
 #include "tcb/metrics.h"
 #include "tcb/rng.h"
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
 
 static double time_pair(const float *v, int K, const int32_t *pred, int reps)
 {
@@ -26,12 +19,12 @@ static double time_pair(const float *v, int K, const int32_t *pred, int reps)
     for (int r = 0; r < reps; r++) {
         tcb_pair_metrics m;
         tcb_error err = {0};
-        double t0 = now_ms();
+        double t0 = bench_now_ms();
         if (tcb_pair_metrics_compute(v, K, pred, &m, &err)) {
             fprintf(stderr, "bench_metrics: %s\n", err.msg);
             exit(1);
         }
-        double t = now_ms() - t0;
+        double t = bench_now_ms() - t0;
         if (t < best) best = t;
     }
     return best;
@@ -39,7 +32,7 @@ static double time_pair(const float *v, int K, const int32_t *pred, int reps)
 
 int main(int argc, char **argv)
 {
-    int reps = argc > 1 ? atoi(argv[1]) : 5;
+    int reps = argc > 1 ? bench_positive_int(argv[1], "reps", "top of bench/metrics.c") : 5;
     static const int sizes[] = {1297, 6890, 10002};
     printf("one pair's metrics, best of %d, %d thread(s)\n", reps, omp_get_max_threads());
     printf("%8s %16s %16s\n", "K", "all wrong ms", "1/3 exact ms");

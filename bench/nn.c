@@ -10,17 +10,10 @@
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <time.h>
 
+#include "bench_util.h"
 #include "tcb/nn.h"
 #include "tcb/rng.h"
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
 
 static double time_backend(tcb_nn_backend backend, const float *pts, const float *queries,
                            int n, int reps, int32_t *idx, float *d2)
@@ -29,13 +22,13 @@ static double time_backend(tcb_nn_backend backend, const float *pts, const float
     for (int r = 0; r < reps; r++) {
         tcb_error err = {0};
         tcb_nn *nn;
-        double t0 = now_ms();
+        double t0 = bench_now_ms();
         if (tcb_nn_build_backend(pts, n, backend, &nn, &err) ||
             tcb_nn_query1(nn, queries, n, idx, d2, &err)) {
             fprintf(stderr, "bench_nn: %s\n", err.msg);
             exit(1);
         }
-        double t = now_ms() - t0;
+        double t = bench_now_ms() - t0;
         tcb_nn_free(nn);
         if (t < best) best = t;
     }
@@ -44,7 +37,7 @@ static double time_backend(tcb_nn_backend backend, const float *pts, const float
 
 int main(int argc, char **argv)
 {
-    int reps = argc > 1 ? atoi(argv[1]) : 5;
+    int reps = argc > 1 ? bench_positive_int(argv[1], "reps", "top of bench/nn.c") : 5;
     static const int sizes[] = {1000, 2500, 5000, 10000, 20000};
     int nmax = sizes[sizeof sizes / sizeof *sizes - 1];
     float *pts = malloc((size_t)nmax * 3 * sizeof(float));

@@ -46,7 +46,10 @@ static void build_row(const tcb_cell_result *cells, int n, tcb_rpt_row *r)
             tcb_summary_merge(&pooled, &c->summary);
         } else if (n_bad++ == 0) {
             r->status = tcb_cell_status_name(c->status);
-            snprintf(r->message, sizeof r->message, "seed %d: %s", c->seed, c->message);
+            /* A message longer than the row's buffer ends in "..." */
+            if (snprintf(r->message, sizeof r->message, "seed %d: %s", c->seed, c->message) >=
+                (int)sizeof r->message)
+                memcpy(r->message + sizeof r->message - 4, "...", 4);
         }
     }
     if (n_bad) {

@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
-# The C atlas network (methods/atlas) against the same network in PyTorch:
-# φ, φ_u, φ_v and the gradients of a random objective of all three, on
-# weights and inputs exported by tests/pytorch/atlas_export.c.
+# The C atlas family (methods/atlas) against the same in PyTorch
+# (tests/pytorch/atlas_torch.py), on weights and inputs that C helpers export:
+#   atlas_export → atlas_net_check.py: the network, φ, φ_u, φ_v and the
+#     gradients of a random objective of all three;
+#   atlas_step_export → atlas_step_check.py: one training step of atlasnet,
+#     dsr and mca: total loss, gradient, Adam update.
 # Skipped (77) when /usr/bin/python3 has no torch (Debian: python3-torch).
 set -euo pipefail
 : "${TCB_SOURCE_DIR:?}" "${TCB_BUILD_DIR:?}" "${CC:=cc}"
@@ -14,12 +17,15 @@ fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
-# The helper uses the library's internal headers; a sanitized library needs
-# a sanitized helper.
+# The helpers use the library's internal headers; a sanitized library needs
+# sanitized helpers.
 sanitize=$(grep -q 'TCB_SANITIZE:BOOL=ON' "$TCB_BUILD_DIR/CMakeCache.txt" && echo "-fsanitize=address,undefined" || true)
-"$CC" -std=c11 -O2 -Wall -Wextra -Werror -D_DEFAULT_SOURCE $sanitize \
-  -I"$TCB_SOURCE_DIR" -I"$TCB_SOURCE_DIR/include" "$TCB_SOURCE_DIR/tests/pytorch/atlas_export.c" \
-  -L"$TCB_BUILD_DIR" -Wl,-rpath,"$TCB_BUILD_DIR" -ltcbench -lm -o "$tmp/atlas_export"
-
-"$tmp/atlas_export" "$tmp"
-/usr/bin/python3 "$TCB_SOURCE_DIR/tests/pytorch/atlas_net_check.py" "$tmp"
+for pair in atlas_export:atlas_net_check atlas_step_export:atlas_step_check; do
+  helper=${pair%%:*} check=${pair##*:}
+  "$CC" -std=c11 -O2 -Wall -Wextra -Werror -D_DEFAULT_SOURCE $sanitize \
+    -I"$TCB_SOURCE_DIR" -I"$TCB_SOURCE_DIR/include" "$TCB_SOURCE_DIR/tests/pytorch/$helper.c" \
+    -L"$TCB_BUILD_DIR" -Wl,-rpath,"$TCB_BUILD_DIR" -ltcbench -lm -o "$tmp/$helper"
+  mkdir "$tmp/$check"
+  "$tmp/$helper" "$tmp/$check"
+  /usr/bin/python3 "$TCB_SOURCE_DIR/tests/pytorch/$check.py" "$tmp/$check"
+done

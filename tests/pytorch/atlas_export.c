@@ -8,26 +8,16 @@
  *     phi.f32, phi_u.f32, phi_v.f32 [B][M][3], grads.f32 [nparams]
  *                                 C's outputs: the network and the gradient of
  *                                 L = Σ a·φ + Σ b·φ_u + Σ c·φ_v
- * (raw float32 in host order; x86 is little-endian, as the script reads).
+ * (raw float32, see export.h).
  *
  * usage: atlas_export DIR */
 #include <stdio.h>
 #include <stdlib.h>
 
 #include "methods/atlas/model.h"
+#include "tests/pytorch/export.h"
 
 enum { C = 64, P = 3, B = 3, N = 100, M = 30 };
-
-static int write_f32(const char *dir, const char *name, const float *x, size_t n)
-{
-    char path[4096];
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    FILE *fp = fopen(path, "wb");
-    int ok = fp && fwrite(x, sizeof(float), n, fp) == n;
-    if (fp && fclose(fp)) ok = 0;
-    if (!ok) fprintf(stderr, "atlas_export: cannot write %s\n", path);
-    return ok ? 0 : 1;
-}
 
 static void fill(tcb_rng *r, float *x, size_t n, double lo, double hi)
 {
@@ -66,26 +56,24 @@ int main(int argc, char **argv)
         return 1;
     }
 
-    char bin[4096], json[4096];
-    snprintf(bin, sizeof bin, "%s/weights.bin", dir);
-    snprintf(json, sizeof json, "%s/weights.json", dir);
-    if (tcb_atlas_model_export(m, bin, json, &err)) {
+    if (export_model(m, dir, "weights", &err)) {
         fprintf(stderr, "atlas_export: %s\n", err.msg);
         return 1;
     }
-    snprintf(json, sizeof json, "%s/case.json", dir);
-    FILE *fp = fopen(json, "w");
+    char json[EXPORT_PATH_MAX];
+    FILE *fp = export_path(json, dir, "case.json") ? NULL : fopen(json, "w");
     if (!fp) return 1;
     fprintf(fp, "{\"C\": %d, \"P\": %d, \"B\": %d, \"N\": %d, \"M\": %d}\n", C, P, B, N, M);
     fclose(fp);
-    int rc = write_f32(dir, "clouds.f32", clouds, B * N * 3) | write_f32(dir, "uv.f32", uv, M * 2) |
-             write_f32(dir, "coef_phi.f32", coef[0], B * M * 3) |
-             write_f32(dir, "coef_phi_u.f32", coef[1], B * M * 3) |
-             write_f32(dir, "coef_phi_v.f32", coef[2], B * M * 3) |
-             write_f32(dir, "phi.f32", out[0], B * M * 3) |
-             write_f32(dir, "phi_u.f32", out[1], B * M * 3) |
-             write_f32(dir, "phi_v.f32", out[2], B * M * 3) |
-             write_f32(dir, "grads.f32", m->grads, m->nparams);
+    int rc = export_f32(dir, "clouds.f32", clouds, B * N * 3) |
+             export_f32(dir, "uv.f32", uv, M * 2) |
+             export_f32(dir, "coef_phi.f32", coef[0], B * M * 3) |
+             export_f32(dir, "coef_phi_u.f32", coef[1], B * M * 3) |
+             export_f32(dir, "coef_phi_v.f32", coef[2], B * M * 3) |
+             export_f32(dir, "phi.f32", out[0], B * M * 3) |
+             export_f32(dir, "phi_u.f32", out[1], B * M * 3) |
+             export_f32(dir, "phi_v.f32", out[2], B * M * 3) |
+             export_f32(dir, "grads.f32", m->grads, m->nparams);
     tcb_atlas_work_free(w);
     tcb_atlas_model_free(m);
     return rc;

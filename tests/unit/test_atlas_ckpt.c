@@ -36,7 +36,9 @@ static tcb_sequence make_seq(void)
 }
 
 /* The mca method's tiny preset with ITERS iterations, as a trainer config. */
-static const tcb_atlas_train_cfg tiny_mca = {TCB_ATLAS_LOSS_METRIC, 200, ITERS, 1e-3, 0.1, 0.001, 1, 1e4};
+static const tcb_atlas_train_cfg tiny_mca = {
+    .loss = TCB_ATLAS_LOSS_METRIC, .M = 200, .iterations = ITERS, .lr = 1e-3, .alpha_mc = 0.1,
+    .alpha_sciso = 0.001, .delta = 1, .divergence = 1e4};
 #define TINY_C 32
 #define TINY_P 4
 

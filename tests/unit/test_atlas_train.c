@@ -93,7 +93,8 @@ static void test_loss_decreases(void **state)
         tcb_rng rng;
         tcb_rng_seed(&rng, 3);
         tcb_atlas_model_init(m, &rng);
-        tcb_atlas_train_cfg cfg = {losses[k], 200, TRAIN_ITERS, 1e-3, 0.1, 0.001, 1, 1e4};
+        tcb_atlas_train_cfg cfg = {.loss = losses[k], .M = 200, .iterations = TRAIN_ITERS, .lr = 1e-3,
+                                   .alpha_mc = 0.1, .alpha_sciso = 0.001, .delta = 1, .divergence = 1e4};
         tcb_atlas_trainer *t;
         assert_int_equal(tcb_atlas_trainer_create(&cfg, m, &s, 7, &t, &err), TCB_OK);
         double loss[TRAIN_ITERS];
@@ -190,7 +191,8 @@ static void test_nan_is_numeric(void **state)
     tcb_rng rng;
     tcb_rng_seed(&rng, 3);
     tcb_atlas_model_init(m, &rng);
-    tcb_atlas_train_cfg cfg = {TCB_ATLAS_LOSS_CHAMFER, 20, 10, 1e-3, 0.1, 0.001, 1, 1e4};
+    tcb_atlas_train_cfg cfg = {.loss = TCB_ATLAS_LOSS_CHAMFER, .M = 20, .iterations = 10, .lr = 1e-3,
+                               .delta = 1, .divergence = 1e4};
     tcb_atlas_trainer *t;
     assert_int_equal(tcb_atlas_trainer_create(&cfg, m, &s, 7, &t, &err), TCB_OK);
     double loss;

@@ -1,0 +1,214 @@
+/* One whole training iteration of the atlas family (tcb_atlas_train_step:
+ * the batch drawn from the point pools, forward, the method's loss,
+ * backward, Adam), for atlasnet (Chamfer, no tangents) and mca (Chamfer +
+ * 0.1·L_mc, with the UV-Jacobians), at the paper's scale (C 1024, P 10,
+ * M 2500, N 2500) and the cpu preset's (C 256, P 10, M 1000, N 2500), beside
+ * the same step in PyTorch on the CPU in the same run
+ * (train_step_torch.py: tests/pytorch/atlas_torch.py's reference step,
+ * autograd's double backward for mca, torch.optim.Adam), printed as the
+ * ratio torch ms / C ms.
+ *
+ * C: a synthetic sequence (6 frames, pools of 10,000 points), one warm-up
+ * step, then the mean of `iters` steps. The PyTorch peer runs after the C
+ * rows of the same (preset, method), with the same sizes, thread count and
+ * warm-up; the C process waits meanwhile.
+ *
+ * GFLOP/s counts the network's minimal FLOPs (atlas_bench.h: the split-
+ * first-layer GEMMs, values + tangents rows for mca, the backward's weight
+ * and input gradients, the encoder); losses and Adam are timed but not
+ * counted. % of peak against --peak, default 230 GFLOP/s: the fp32 FMA peak
+ * of 2 Zen 4 cores (2 × 32 FLOP/cycle × 3.6 GHz); pass the peak of the cores
+ * used (--threads) where they are fewer than the machine's. RSS: each process's peak
+ * resident set (getrusage ru_maxrss); the C process's is its peak so far,
+ * as the rows run from the smaller preset up.
+ *
+ * Targets (issue 3): C ≥ 4× faster than PyTorch for the mca step at paper
+ * scale, ≥ 3× for atlasnet, the step at ≥ 60 % of peak. Timings only;
+ * nothing is asserted.
+ *
+ * usage: bench_train_step [--iters N] [--threads T] [--preset paper|cpu|all]
+ *                         [--peak GFLOPS] [--no-torch] [--torch SCRIPT]
+ * Defaults: 5 iterations, the OpenMP thread count, all presets, the peer
+ * train_step_torch.py next to this file run by /usr/bin/python3. */
+#include <omp.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+
+#include "atlas_bench.h"
+#include "methods/atlas/train.h"
+#include "tcb/synth.h"
+
+enum { P = 10, N = 2500, FRAMES = 6, PEER_SKIPPED = 77 };
+
+typedef struct {
+    const char *name;
+    int C, M;
+} preset;
+
+static const preset presets[] = {{"cpu", 256, 1000}, {"paper", 1024, 2500}};
+
+static const struct {
+    const char *name;
+    tcb_atlas_loss loss;
+    int nt; /* tangents per value */
+} methods[] = {{"atlasnet", TCB_ATLAS_LOSS_CHAMFER, 0}, {"mca", TCB_ATLAS_LOSS_METRIC, 2}};
+
+typedef struct {
+    int iters, threads, torch;
+    double peak;
+    const char *preset; /* NULL: all */
+    char script[4096];
+} options;
+
+static void die(const char *fmt, ...) __attribute__((format(printf, 1, 2), noreturn));
+
+static void die(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "bench_train_step: ");
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+    exit(1);
+}
+
+static void make_sequence(tcb_sequence *s)
+{
+    tcb_error err = {0};
+    if (tcb_synth_generate("quadruped_walk", 1, FRAMES, s, &err) ||
+        tcb_sequence_normalize(s, TCB_NORM_FIRST_FRAME, &err) ||
+        tcb_sequence_sample_pools(s, TCB_DEFAULT_POOL_SIZE, 1, &err))
+        die("%s", err.msg);
+    s->input_points = N, s->draw_with_replacement = 0;
+}
+
+/* Mean ms per tcb_atlas_train_step of a fresh model, after one warm-up. */
+static double time_c(const preset *pr, tcb_atlas_loss loss, const tcb_sequence *seq, int iters)
+{
+    tcb_error err = {0};
+    tcb_atlas_model *m;
+    if (tcb_atlas_model_create(pr->C, P, &m, &err)) die("%s", err.msg);
+    tcb_rng rng;
+    tcb_rng_seed_stream(&rng, 1, "bench/train_step");
+    tcb_atlas_model_init(m, &rng);
+    tcb_atlas_train_cfg cfg = {.loss = loss, .M = pr->M, .iterations = 200000, .lr = 1e-3,
+                               .alpha_mc = 0.1, .alpha_sciso = 1e-3, .delta = 1};
+    tcb_atlas_trainer *t;
+    if (tcb_atlas_trainer_create(&cfg, m, seq, 1, &t, &err)) die("%s", err.msg);
+    double value, t0 = 0;
+    for (int it = 0; it <= iters; it++) {
+        if (it == 1) t0 = bench_now_ms();
+        if (tcb_atlas_train_step(t, seq, &value, &err)) die("%s", err.msg);
+    }
+    double ms = (bench_now_ms() - t0) / iters;
+    tcb_atlas_trainer_free(t);
+    tcb_atlas_model_free(m);
+    return ms;
+}
+
+/* Runs the PyTorch peer: 0 with *ms and *rss_kib, PEER_SKIPPED when it has
+ * no torch, -1 when it failed. */
+static int time_torch(const options *o, const preset *pr, const char *method, double *ms,
+                      long *rss_kib)
+{
+    char cmd[8192];
+    if ((size_t)snprintf(cmd, sizeof cmd, "/usr/bin/python3 '%s' %s %d %d %d %d %d %d", o->script,
+                         method, pr->C, P, pr->M, N, o->iters, o->threads) >= sizeof cmd)
+        return -1;
+    fflush(stdout);
+    FILE *p = popen(cmd, "r");
+    if (!p) return -1;
+    int ok = fscanf(p, "%lf %ld", ms, rss_kib) == 2;
+    int status = pclose(p);
+    if (status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == PEER_SKIPPED)
+        return PEER_SKIPPED;
+    return ok && status == 0 ? 0 : -1;
+}
+
+static double peak_rss_mib(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return ru.ru_maxrss / 1024.0;
+}
+
+static void print_header(const options *o)
+{
+    printf("atlas training step (tcb_atlas_train_step), B=4 P=%d N=%d, %d thread(s), mean of %d "
+           "iteration(s) after 1 warm-up\n", P, N, o->threads, o->iters);
+    printf("GFLOP/it = 2 x minimal multiply-adds of forward + backward (bench/atlas_bench.h):\n"
+           "  encoder B*N*(3*64 + 64*128 + 128*C) + 2*B*C^2; per patch B*C*H1 + B*m*2*H1\n"
+           "  + (1+nt)*B*m*(H1*H2 + H2*H3 + 3*H3), m = M/P, H1 = C+2, H2 = H1/2, H3 = H1/4,\n"
+           "  nt = 2 tangents (mca) or 0 (atlasnet); backward ~2x (exact count in the header);\n"
+           "  loss and Adam not counted. Peak %.0f GFLOP/s.\n", o->peak);
+    printf("%-6s %-9s %8s %9s %8s %6s %10s %8s %9s %9s\n", "preset", "method", "GFLOP/it",
+           "C ms/it", "GFLOP/s", "%peak", "torch ms", "torch/C", "C RSS MiB", "torch MiB");
+}
+
+static void run_row(options *o, const preset *pr, int k, const tcb_sequence *seq)
+{
+    double fwd, bwd;
+    bench_atlas_macs(pr->C, P, pr->M, 4, N, methods[k].nt, &fwd, &bwd);
+    double gflop = 2 * (fwd + bwd) * 1e-9;
+    double ms = time_c(pr, methods[k].loss, seq, o->iters), gfs = gflop / ms * 1e3;
+    double c_rss = peak_rss_mib(), tms = 0;
+    long rss = 0;
+    int rc = o->torch ? time_torch(o, pr, methods[k].name, &tms, &rss) : PEER_SKIPPED;
+    printf("%-6s %-9s %8.1f %9.1f %8.1f %5.0f%%", pr->name, methods[k].name, gflop, ms, gfs,
+           100 * gfs / o->peak);
+    if (rc == 0)
+        printf(" %10.1f %8.2f %9.0f %9.0f\n", tms, tms / ms, c_rss, rss / 1024.0);
+    else
+        printf(" %10s %8s %9.0f %9s\n", "n/a", "n/a", c_rss, "n/a");
+    if (rc == PEER_SKIPPED && o->torch) {
+        printf("PyTorch peer: unavailable (install python3-torch)\n");
+        o->torch = 0;
+    } else if (rc < 0) {
+        printf("PyTorch peer: failed (%s)\n", o->script);
+    }
+    fflush(stdout);
+}
+
+static void parse(int argc, char **argv, options *o)
+{
+    *o = (options){.iters = 5, .threads = omp_get_max_threads(), .torch = 1, .peak = 230};
+    bench_sibling_path(o->script, sizeof o->script, __FILE__, "train_step_torch.py");
+    for (int a = 1; a < argc; a++) {
+        const char *v = a + 1 < argc ? argv[a + 1] : NULL;
+        if (strcmp(argv[a], "--no-torch") == 0) o->torch = 0;
+        else if (!v) die("bad argument %s (usage: top of bench/train_step.c)", argv[a]);
+        else if (strcmp(argv[a], "--iters") == 0) o->iters = bench_positive_int(v, "--iters", "top of bench/train_step.c"), a++;
+        else if (strcmp(argv[a], "--threads") == 0) o->threads = bench_positive_int(v, "--threads", "top of bench/train_step.c"), a++;
+        else if (strcmp(argv[a], "--peak") == 0) o->peak = atof(v), a++;
+        else if (strcmp(argv[a], "--preset") == 0) o->preset = strcmp(v, "all") ? v : NULL, a++;
+        else if (strcmp(argv[a], "--torch") == 0)
+            snprintf(o->script, sizeof o->script, "%s", v), a++;
+        else die("bad argument %s (usage: top of bench/train_step.c)", argv[a]);
+    }
+    if (o->iters < 1 || o->threads < 1 || o->peak <= 0)
+        die("--iters, --threads and --peak must be > 0");
+    if (o->preset && strcmp(o->preset, "cpu") && strcmp(o->preset, "paper"))
+        die("--preset must be paper, cpu or all");
+}
+
+int main(int argc, char **argv)
+{
+    options o;
+    parse(argc, argv, &o);
+    /* before any work is created: the trainer sizes its pool from it */
+    omp_set_num_threads(o.threads);
+    tcb_sequence seq = {0};
+    make_sequence(&seq);
+    print_header(&o);
+    for (size_t i = 0; i < sizeof presets / sizeof *presets; i++)
+        for (size_t k = 0; k < sizeof methods / sizeof *methods; k++)
+            if (!o.preset || strcmp(o.preset, presets[i].name) == 0)
+                run_row(&o, &presets[i], (int)k, &seq);
+    tcb_sequence_free(&seq);
+    return 0;
+}

@@ -1,0 +1,62 @@
+"""PyTorch peer of bench_train_step: the reference training step of one atlas
+method (tests/pytorch/atlas_torch.py: forward, the method's loss with the
+UV-Jacobians by autograd for dsr and mca, backward, which is then a double
+backward, torch.optim.Adam at lr 1e-3) on a batch of 4 shapes, float32 on
+the CPU with torch.set_num_threads(threads); the Chamfer loss's distance
+matrix by torch's fast GEMM form.
+
+The batch's clouds are drawn once (data loading is not part of the step, as
+in TCSR, whose DataLoader prepares batches aside); the UV samples are fresh
+every iteration, as in training. `warmup` steps, then `iters` timed steps.
+
+Prints one line: "<mean ms per step> <peak RSS of this process in KiB>".
+Exit 77 (and a message on stderr) when torch cannot be imported.
+
+usage: train_step_torch.py METHOD C P M N ITERS THREADS [WARMUP]
+"""
+import os
+import resource
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "tests", "pytorch"))
+try:
+    import torch
+
+    import atlas_torch
+except ImportError as exc:
+    print(f"unavailable: {exc}", file=sys.stderr)
+    sys.exit(77)
+
+BATCH = 4
+
+
+def main():
+    method = sys.argv[1]
+    c, p, m, n, iters, threads = (int(a) for a in sys.argv[2:8])
+    warmup = int(sys.argv[8]) if len(sys.argv) > 8 else 1
+    torch.set_num_threads(threads)
+    torch.manual_seed(1)
+    model = atlas_torch.Atlas(c, p)
+    opt = torch.optim.Adam(model.parameters(), lr=1e-3)
+    clouds = torch.rand(BATCH, n, 3) - 0.5
+    area = torch.ones(BATCH)
+
+    def step():
+        opt.zero_grad()
+        atlas_torch.method_loss(method, model, clouds, torch.rand(m, 2), area,
+                                exact_nn=False).backward()
+        opt.step()
+
+    for _ in range(warmup):
+        step()
+    t0 = time.perf_counter()
+    for _ in range(iters):
+        step()
+    ms = (time.perf_counter() - t0) * 1e3 / iters
+    print(f"{ms:.3f} {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss}")
+
+
+if __name__ == "__main__":
+    main()
