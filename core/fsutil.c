@@ -1,6 +1,8 @@
 #include "tcb/fsutil.h"
 
+#include <dirent.h>
 #include <errno.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -63,7 +65,9 @@ int tcb_temp_path_for(const char *path, char *tmp, size_t tmp_size, tcb_error *e
 {
     int rc = make_parent(path, err);
     if (rc) return rc;
-    if (tcb_path_join(tmp, tmp_size, err, "%s.tmp-XXXXXX", path)) return TCB_ERR_INPUT;
+    /* The writer's pid in the name tells a killed writer's debris from the
+     * temporary of a live concurrent writer (tcb_remove_stale_temps). */
+    if (tcb_path_join(tmp, tmp_size, err, "%s.tmp-%ld-XXXXXX", path, (long)getpid())) return TCB_ERR_INPUT;
     int fd = mkstemp(tmp);
     if (fd < 0) return tcb_fail(err, TCB_ERR_IO, "%s: cannot create temporary file: %s", tmp, strerror(errno));
     /* mkstemp creates 0600; results, reports and caches are meant to be shared. */
@@ -159,4 +163,32 @@ int tcb_read_file(const char *path, char **data, size_t *len, tcb_error *err)
     *data = buf;
     if (len) *len = size;
     return TCB_OK;
+}
+
+/* A temporary ("….tmp-<pid>-XXXXXX") whose writer is gone; names without a
+ * parsable pid count as stale. A reused pid keeps debris, never loses data. */
+static int is_stale_temp(const char *name)
+{
+    const char *t = strstr(name, ".tmp-");
+    if (!t) return 0;
+    char *end;
+    errno = 0;
+    long pid = strtol(t + 5, &end, 10);
+    if (errno || end == t + 5 || *end != '-' || pid <= 0) return 1;
+    return kill((pid_t)pid, 0) != 0 && errno == ESRCH;
+}
+
+void tcb_remove_stale_temps(const char *dir, const char *prefix)
+{
+    DIR *d = opendir(dir);
+    if (!d) return;
+    size_t plen = strlen(prefix);
+    for (struct dirent *e; (e = readdir(d));) {
+        char victim[TCB_PATH_MAX];
+        if (strncmp(e->d_name, prefix, plen) != 0 || !is_stale_temp(e->d_name)) continue;
+        if ((size_t)snprintf(victim, sizeof victim, "%s/%s", dir, e->d_name) < sizeof victim &&
+            tcb_is_file(victim))
+            remove(victim);
+    }
+    closedir(d);
 }

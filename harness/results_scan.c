@@ -54,7 +54,7 @@ static int scan_file(const char *run_dir, const char *path, cell_list *l, tcb_er
 }
 
 /* Only *.json files are cells: the temporaries of an atomic write in
- * progress end in ".tmp-XXXXXX". Hidden entries are never cells either. */
+ * progress end in ".tmp-<pid>-XXXXXX". Hidden entries are never cells either. */
 static int scan_dir(const char *run_dir, const char *dir, cell_list *l, tcb_error *err)
 {
     DIR *d = opendir(dir);

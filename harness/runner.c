@@ -26,22 +26,6 @@ typedef struct run_state {
     tcb_run_stats *stats;
 } run_state;
 
-/* Unlinks the regular files in `dir` whose names start with `prefix` and
- * contain `infix` ("" matches anything). */
-static void remove_files(const char *dir, const char *prefix, const char *infix)
-{
-    DIR *d = opendir(dir);
-    if (!d) return;
-    for (struct dirent *e; (e = readdir(d));) {
-        char victim[TCB_PATH_MAX];
-        if (strncmp(e->d_name, prefix, strlen(prefix)) != 0 || !strstr(e->d_name, infix)) continue;
-        if ((size_t)snprintf(victim, sizeof victim, "%s/%s", dir, e->d_name) < sizeof victim &&
-            tcb_is_file(victim))
-            remove(victim);
-    }
-    closedir(d);
-}
-
 /* Unlinks "<path>.tmp-*" left by a writer killed before its rename: a
  * resumed run must not leave debris that a finished run would not have. */
 static void remove_stale_temps(const char *path)
@@ -53,7 +37,7 @@ static void remove_stale_temps(const char *path)
     if (slash) *slash = '\0';
     char prefix[TCB_PATH_MAX];
     if ((size_t)snprintf(prefix, sizeof prefix, "%s.tmp-", base) >= sizeof prefix) return;
-    remove_files(slash ? dir : ".", prefix, "");
+    tcb_remove_stale_temps(slash ? dir : ".", prefix);
 }
 
 /* A cell's work directory holds only its method's checkpoints (the model
@@ -62,7 +46,19 @@ static void remove_stale_temps(const char *path)
  * go. */
 static void prepare_work_dir(const char *work, int force)
 {
-    remove_files(work, "", force ? "" : ".tmp-");
+    if (!force) {
+        tcb_remove_stale_temps(work, "");
+        return;
+    }
+    DIR *d = opendir(work);
+    if (!d) return;
+    for (struct dirent *e; (e = readdir(d));) {
+        char victim[TCB_PATH_MAX];
+        if ((size_t)snprintf(victim, sizeof victim, "%s/%s", work, e->d_name) < sizeof victim &&
+            tcb_is_file(victim))
+            remove(victim);
+    }
+    closedir(d);
 }
 
 static int load_plugins(const tcb_config *cfg, tcb_error *err)

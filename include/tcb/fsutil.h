@@ -35,6 +35,12 @@ void tcb_atomic_abort(tcb_atomic_file *af);
 int tcb_temp_path_for(const char *path, char *tmp, size_t tmp_size, tcb_error *err);
 int tcb_publish(const char *tmp, const char *path, tcb_error *err);
 
+/* Unlinks the temporaries in `dir` whose names start with `prefix` ("" for
+ * all) and whose writer has exited: what a killed run left behind. The
+ * temporaries of live writers (another tcbench process working on the same
+ * run) are kept. */
+void tcb_remove_stale_temps(const char *dir, const char *prefix);
+
 int tcb_write_file_atomic(const char *path, const void *data, size_t len,
                           tcb_error *err);
 

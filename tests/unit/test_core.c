@@ -127,6 +127,32 @@ static void test_atomic_write_commit_and_abort(void **state)
     tu_remove_tree(dir);
 }
 
+/* Debris of killed writers goes; a live writer's temporary (this process's,
+ * as from tcb_atomic_open) stays, and so does everything else. */
+static void test_stale_temps_only(void **state)
+{
+    const char *dir = *state;
+    char live[TCB_PATH_MAX], dead[TCB_PATH_MAX], odd[TCB_PATH_MAX], other[TCB_PATH_MAX], keep[TCB_PATH_MAX];
+    tcb_error err;
+    tcb_atomic_file af;
+    snprintf(live, sizeof live, "%s/c.json", dir);
+    assert_int_equal(tcb_atomic_open(&af, live, &err), TCB_OK);
+    tu_write_text(dir, "c.json.tmp-2147483646-Ab12Cd", "", dead, sizeof dead); /* above any pid_max */
+    tu_write_text(dir, "c.json.tmp-Ab12Cd", "", odd, sizeof odd);
+    tu_write_text(dir, "d.json.tmp-2147483646-Ab12Cd", "", other, sizeof other);
+    tu_write_text(dir, "c.json", "{}", keep, sizeof keep);
+    tcb_remove_stale_temps(dir, "c.json.tmp-");
+    assert_true(tcb_is_file(af.tmp));
+    assert_false(tcb_is_file(dead));
+    assert_false(tcb_is_file(odd));
+    assert_true(tcb_is_file(other));
+    assert_true(tcb_is_file(keep));
+    tcb_remove_stale_temps(dir, "");
+    assert_false(tcb_is_file(other));
+    assert_true(tcb_is_file(af.tmp));
+    assert_int_equal(tcb_atomic_commit(&af, &err), TCB_OK);
+}
+
 static void test_path_join_refuses_truncation(void **state)
 {
     (void)state;
@@ -214,6 +240,7 @@ int main(void)
         cmocka_unit_test(test_rng_is_reproducible_and_streams_differ),
         cmocka_unit_test(test_rng_distributions),
         cmocka_unit_test(test_atomic_write_commit_and_abort),
+        cmocka_unit_test_setup_teardown(test_stale_temps_only, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test(test_path_join_refuses_truncation),
         cmocka_unit_test(test_json_errors_name_the_key),
         cmocka_unit_test(test_progress_plain_lines_when_not_a_tty),
