@@ -31,7 +31,8 @@ pid=""
 [ -s "killed/$work/train.ckpt" ] && [ ! -e killed/cells/synth/quadruped_walk/mca/seed_0.json ] ||
     { echo "FAIL: the kill did not land between the first checkpoint and the end"; exit 1; }
 
-"$TCBENCH" run train.json --out killed 2> resume.log
+# Not quiet (CI=true would be): the resume is announced at log level info.
+CI= "$TCBENCH" run train.json --out killed 2> resume.log
 grep -q "resuming training at iteration [1-9]" resume.log || { echo "FAIL: did not resume"; cat resume.log; exit 1; }
 same_cells full killed
 leftovers=$(find killed -name '*.tmp-*' -o -name train.ckpt)
