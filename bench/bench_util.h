@@ -3,6 +3,7 @@
 #define TCB_BENCH_UTIL_H
 
 #include <errno.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,6 +25,20 @@ static inline void bench_sibling_path(char *out, size_t size, const char *file, 
     char *slash = strrchr(out, '/');
     size_t dir = slash ? (size_t)(slash + 1 - out) : 0;
     snprintf(out + dir, size - dir, "%s", name);
+}
+
+/* Prints "<prog>: <message>" and exits 1. */
+static inline void bench_die(const char *prog, const char *fmt, ...) __attribute__((format(printf, 2, 3), noreturn));
+
+static inline void bench_die(const char *prog, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "%s: ", prog);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+    exit(1);
 }
 
 /* A positive integer argument, or exit(2) with a message naming `what` and

@@ -23,18 +23,7 @@
 #include "tcb/lap.h"
 #include "tcb/rng.h"
 
-static void die(const char *fmt, ...) __attribute__((format(printf, 1, 2), noreturn));
-
-static void die(const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    fprintf(stderr, "bench_lap: ");
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
-    va_end(ap);
-    exit(1);
-}
+#define die(...) bench_die("bench_lap", __VA_ARGS__)
 
 /* Returns the [n_rows][n_cols] matrix, malloc'ed; exits on a malformed file. */
 static double *read_matrix(const char *path, int *n_rows, int *n_cols)

@@ -64,18 +64,7 @@ typedef struct {
     char script[4096];
 } options;
 
-static void die(const char *fmt, ...) __attribute__((format(printf, 1, 2), noreturn));
-
-static void die(const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    fprintf(stderr, "bench_train_step: ");
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
-    va_end(ap);
-    exit(1);
-}
+#define die(...) bench_die("bench_train_step", __VA_ARGS__)
 
 static void make_sequence(tcb_sequence *s)
 {
