@@ -91,11 +91,18 @@ static int create_method(const tcb_cell_job *job, void **self, tcb_error *merr)
 static int prepare_method(const tcb_cell_job *job, void **self, tcb_error *merr)
 {
     const tcb_method_ops *ops = job->ops;
+    if (job->require_checkpoint && ops->load && !tcb_is_file(job->checkpoint))
+        return tcb_fail(merr, TCB_ERR_IO, "%s: no such file: the cell has no fitted model yet",
+                        job->checkpoint);
     int rc = create_method(job, self, merr);
     if (rc) return rc;
     if (ops->load && job->reuse_checkpoint && tcb_is_file(job->checkpoint)) {
         tcb_error le = {0};
         if (ops->load(*self, job->seq, job->checkpoint, &le) == TCB_OK) return TCB_OK;
+        if (job->require_checkpoint) {
+            ops->destroy(*self);
+            return tcb_fail(merr, le.code ? le.code : TCB_ERR_INPUT, "%s", le.msg);
+        }
         /* A model half-loaded from a bad checkpoint is not trusted: start over. */
         tcb_report_log(&job->reporter, TCB_LOG_WARN, "%s: not reused (%s); fitting again",
                        job->checkpoint, le.msg);
@@ -116,9 +123,10 @@ static int prepare_method(const tcb_cell_job *job, void **self, tcb_error *merr)
 }
 
 /* Reconstruct `frame` in the context of pair (i, j) and score it against
- * the frame's GT vertices. */
+ * the frame's GT vertices; the points go to *keep (NULL: freed). */
 static void reconstruction_cd(const tcb_cell_job *job, void *self, int i, int j, int frame,
-                              tcb_rng *rng, double *cd, tcb_error *merr, tcb_error *herr)
+                              tcb_rng *rng, double *cd, float **keep, int *keep_n,
+                              tcb_error *merr, tcb_error *herr)
 {
     const tcb_sequence *seq = job->seq;
     float *pts = NULL;
@@ -135,13 +143,19 @@ static void reconstruction_cd(const tcb_cell_job *job, void *self, int i, int j,
                  "reconstruct frame %d (pair %d->%d): returned a non-finite point", frame, i, j);
     else
         tcb_chamfer(pts, n, tcb_seq_frame(seq, frame), seq->n_verts, cd, herr);
+    if (keep && !merr->code && !herr->code) {
+        *keep = pts, *keep_n = n;
+        return;
+    }
     free(pts);
 }
 
-/* Pair k of the split into rec and the summary. Failures land in merr
- * (the method's) or herr (the harness's); the caller checks both. */
+/* Pair k of the split into rec and the summary; with `cap`, its metrics
+ * and reconstructions are kept there too. Failures land in merr (the
+ * method's) or herr (the harness's); the caller checks both. */
 static void eval_pair(const tcb_cell_job *job, void *self, int k, eval_bufs *b,
-                      tcb_pair_record *rec, tcb_summary *sum, tcb_error *merr, tcb_error *herr)
+                      tcb_pair_record *rec, tcb_summary *sum, tcb_pair_capture *cap,
+                      tcb_error *merr, tcb_error *herr)
 {
     const tcb_sequence *seq = job->seq;
     int nv = seq->n_verts;
@@ -170,13 +184,17 @@ static void eval_pair(const tcb_cell_job *job, void *self, int k, eval_bufs *b,
     double cd = NAN;
     if (job->ops->reconstruct) {
         double cd_i = 0, cd_j = 0;
-        reconstruction_cd(job, self, i, j, i, &rng, &cd_i, merr, herr);
-        if (!merr->code && !herr->code) reconstruction_cd(job, self, i, j, j, &rng, &cd_j, merr, herr);
+        reconstruction_cd(job, self, i, j, i, &rng, &cd_i, cap ? &cap->recon[0] : NULL,
+                          cap ? &cap->n_recon[0] : NULL, merr, herr);
+        if (!merr->code && !herr->code)
+            reconstruction_cd(job, self, i, j, j, &rng, &cd_j, cap ? &cap->recon[1] : NULL,
+                              cap ? &cap->n_recon[1] : NULL, merr, herr);
         if (merr->code || herr->code) return;
         cd = 0.5 * (cd_i + cd_j);
     }
     *rec = (tcb_pair_record){i, j, pm.sl2, pm.sl2sq, pm.rank, pm.auc, cd};
     tcb_summary_add_pair(sum, &pm, cd);
+    if (cap) cap->i = i, cap->j = j, cap->metrics = pm;
 }
 
 static void evaluate(const tcb_cell_job *job, void *self, tcb_cell_result *c, tcb_error *merr,
@@ -194,7 +212,7 @@ static void evaluate(const tcb_cell_job *job, void *self, tcb_cell_result *c, tc
                        job->method->label, job->seed);
         tcb_report_progress(&job->reporter, 0, split->n_pairs, label);
         for (int k = 0; k < split->n_pairs && !merr->code && !herr->code; k++) {
-            eval_pair(job, self, k, &b, &c->pairs[k], &c->summary, merr, herr);
+            eval_pair(job, self, k, &b, &c->pairs[k], &c->summary, NULL, merr, herr);
             tcb_report_progress(&job->reporter, k + 1, split->n_pairs, label);
         }
         c->n_pairs = split->n_pairs;
@@ -241,4 +259,40 @@ int tcb_cell_run(const tcb_cell_job *job, tcb_cell_result *out, tcb_error *err)
 fail:
     tcb_cell_free(out);
     return tcb_fail(err, herr.code, "%s", herr.msg);
+}
+
+int tcb_cell_eval_pair(const tcb_cell_job *job, int k, tcb_pair_capture *out, tcb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (k < 0 || k >= job->split->n_pairs)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: no pair %d (the split has %d: 0 to %d)",
+                        job->split_path, k, job->split->n_pairs, job->split->n_pairs - 1);
+    tcb_error merr = {0}, herr = {0};
+    size_t nv = (size_t)job->seq->n_verts;
+    eval_bufs b = {malloc(nv * 3 * sizeof(float)), malloc(nv * sizeof(int32_t))};
+    void *self;
+    if (!b.moved || !b.pred) {
+        tcb_fail(&herr, TCB_ERR_NOMEM, "out of memory for %zu vertices", nv);
+    } else if (prepare_method(job, &self, &merr) == TCB_OK) {
+        tcb_pair_record rec;
+        tcb_summary sum;
+        tcb_summary_init(&sum);
+        eval_pair(job, self, k, &b, &rec, &sum, out, &merr, &herr);
+        out->cd = rec.cd;
+        job->ops->destroy(self);
+    }
+    out->moved = b.moved, out->pred = b.pred;
+    if (!herr.code && !merr.code) return TCB_OK;
+    tcb_pair_capture_free(out);
+    if (herr.code) return tcb_fail(err, herr.code, "%s", herr.msg);
+    return tcb_fail(err, merr.code, "%s: %s", job->method->label, merr.msg);
+}
+
+void tcb_pair_capture_free(tcb_pair_capture *c)
+{
+    free(c->moved);
+    free(c->pred);
+    free(c->recon[0]);
+    free(c->recon[1]);
+    memset(c, 0, sizeof *c);
 }

@@ -7,6 +7,7 @@
 
 #include "tcb/config.h"
 #include "tcb/method.h"
+#include "tcb/metrics.h"
 #include "tcb/results.h"
 #include "tcb/sequence.h"
 #include "tcb/split.h"
@@ -32,6 +33,27 @@ long tcb_peak_rss_kb(void);
 void tcb_cell_label(char *out, size_t size, const char *dataset, const char *sequence,
                     const char *method, int seed);
 
+/* Loads the config's "plugins"; errors name the config and the entry.
+ * (harness/runner.c) */
+int tcb_harness_load_plugins(const tcb_config *cfg, tcb_error *err);
+
+/* The sequence as the runner loads it for dataset d: generated or read
+ * (through the cache), normalized, pools drawn, input settings set. On
+ * failure *seq is freed and the message names dataset and sequence.
+ * (harness/runner.c) */
+int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, const char *name,
+                              tcb_sequence *seq, tcb_error *err);
+/* <splits_dir>/<dataset>/<sequence>.json into *split (made once, then
+ * reused; a file made for other settings is refused, so every method sees
+ * the same pairs); its path in path[size]. */
+int tcb_harness_obtain_split(const tcb_config *cfg, const tcb_dataset_spec *d,
+                             const tcb_sequence_spec *s, int n_frames, char *path, size_t size,
+                             tcb_split *split, tcb_error *err);
+/* A cell's work directory <run>/work/<dataset>/<sequence>/<label>/seed_<s>
+ * and its model checkpoint <work>/model.ckpt, both [TCB_PATH_MAX]. */
+int tcb_harness_work_paths(const char *run_dir, const char *dataset, const char *sequence,
+                           const char *label, int seed, char *work, char *ckpt, tcb_error *err);
+
 /* Everything one cell needs besides the method: the loaded sequence, its
  * split and where its files go. */
 typedef struct tcb_cell_job {
@@ -44,6 +66,7 @@ typedef struct tcb_cell_job {
     int seed;
     int threads;
     int reuse_checkpoint;     /* load `checkpoint` when present instead of fitting */
+    int require_checkpoint;   /* a method that saves must load `checkpoint`: never refit */
     const char *work_dir;     /* created by the caller */
     const char *checkpoint;   /* <work_dir>/model.ckpt, written after fit when ops->save */
     const char *git_revision;
@@ -56,5 +79,24 @@ typedef struct tcb_cell_job {
  * for harness failures (out of memory, metrics given bad input). Free *out
  * with tcb_cell_free. (harness/cell.c) */
 int tcb_cell_run(const tcb_cell_job *job, tcb_cell_result *out, tcb_error *err);
+
+/* One evaluation pair of a cell exactly as tcb_cell_run computes it (same
+ * method state, random stream and projection), with what it produced. */
+typedef struct tcb_pair_capture {
+    int i, j;                 /* frames: source, target */
+    float *moved;             /* [n_verts][3] the method's transfer of frame i's vertices */
+    int32_t *pred;            /* [n_verts] predicted vertex ids of frame j */
+    tcb_pair_metrics metrics;
+    double cd;                /* NaN without reconstruct */
+    float *recon[2];          /* [n_recon[f]][3] surface samples of frames i, j, or NULL */
+    int n_recon[2];
+} tcb_pair_capture;
+
+/* Creates the method, loads (or, for methods without checkpoints, fits) it
+ * and evaluates pair k of job->split into *out; a method's failure is an
+ * error here, prefixed with its label. Free *out with tcb_pair_capture_free.
+ * (harness/cell.c) */
+int tcb_cell_eval_pair(const tcb_cell_job *job, int k, tcb_pair_capture *out, tcb_error *err);
+void tcb_pair_capture_free(tcb_pair_capture *c);
 
 #endif

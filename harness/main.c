@@ -210,6 +210,32 @@ static int cmd_check(const cli *c)
     return 1;
 }
 
+static int cmd_inspect(const cli *c)
+{
+    long long seed, threads, pair = -1;
+    if (int_option(c, F_SEED, -1, &seed) || int_option(c, F_THREADS, 0, &threads)) return 2;
+    if (strcmp(c->arg[2], "worst") != 0) {
+        char *end;
+        errno = 0;
+        pair = strtoll(c->arg[2], &end, 10);
+        if (!*c->arg[2] || *end || errno || pair < 0 || pair > 1000000000)
+            return usage_error("inspect", "PAIR: expected a pair index or 'worst', got '%s'",
+                               c->arg[2]);
+    }
+    tcb_term_progress tp;
+    tcb_term_progress_init(&tp, stderr, c->set[F_QUIET] ? 1 : -1);
+    tcb_inspect_opts o = {c->arg[0], c->arg[1], (int)pair, (int)(seed > 1000000000 ? -1 : seed),
+                          c->value[F_SEQUENCE], c->value[F_OUT],
+                          (int)(threads > 1024 ? 1024 : threads), tcb_term_progress_reporter(&tp)};
+    tcb_error err = {0};
+    char dir[TCB_PATH_MAX];
+    int rc = tcb_inspect(&o, stdout, dir, &err);
+    tcb_term_progress_finish(&tp);
+    if (rc) return fail(&err);
+    fprintf(stderr, "files: %s/\n", dir);
+    return 0;
+}
+
 static int cmd_version(const cli *c)
 {
     (void)c;
@@ -295,6 +321,32 @@ static const command commands[] = {
      "\n"
      "example:\n"
      "  tcbench check runs/quick tests/baselines/quick.json\n"},
+    {"inspect", cmd_inspect, BIT(F_SEED) | BIT(F_SEQUENCE) | BIT(F_OUT) | BIT(F_THREADS) | BIT(F_QUIET),
+     3, 3, "RUN_DIR METHOD PAIR",
+     "usage: tcbench inspect RUN_DIR METHOD PAIR [--seed S] [--sequence DATASET/SEQUENCE]\n"
+     "                       [--out DIR] [--threads N] [--quiet]\n"
+     "\n"
+     "Recomputes one evaluation pair of a cell exactly as the run did (from the\n"
+     "cell's fitted model), checks it against the cell file, and writes it as\n"
+     "coloured meshes: source.ply and target.ply (vertices coloured by their place\n"
+     "on the body), transfer.ply (each target vertex in the colour of the vertex the\n"
+     "method predicted for it), error.ply (per-vertex error), recon_i/recon_j.ply\n"
+     "(the method's surface samples, if it reconstructs), vertices.csv and pair.json.\n"
+     "\n"
+     "PAIR is the pair's index in the split, or 'worst': the cell's pair with the\n"
+     "largest m_sL2.\n"
+     "\n"
+     "options:\n"
+     "  --seed S          the cell's seed (default: the run's first)\n"
+     "  --sequence D/S    dataset/sequence (default: the run's only one)\n"
+     "  --out DIR         where to write (default:\n"
+     "                    RUN_DIR/inspect/<dataset>/<sequence>/<method>/seed_<s>/pair_<k>)\n"
+     "  --threads N       threads (default: the run's; the same count reproduces the\n"
+     "                    cell's numbers bit for bit)\n"
+     "  --quiet           no progress output\n"
+     "\n"
+     "example:\n"
+     "  tcbench inspect runs/atlas-cat mca worst --seed 1\n"},
     {"version", cmd_version, 0, 0, 0, "",
      "usage: tcbench version\n"
      "\n"
@@ -324,6 +376,7 @@ static const char general_help[] =
     "  methods   list the registered methods\n"
     "  datasets  list or export the synthetic sequences\n"
     "  check     compare a run with a baseline (CI regression check)\n"
+    "  inspect   one evaluation pair as coloured meshes, checked against the run\n"
     "  version   print the version\n"
     "  help      help on a command\n"
     "\n"

@@ -61,7 +61,7 @@ static void prepare_work_dir(const char *work, int force)
     closedir(d);
 }
 
-static int load_plugins(const tcb_config *cfg, tcb_error *err)
+int tcb_harness_load_plugins(const tcb_config *cfg, tcb_error *err)
 {
     for (int k = 0; k < cfg->n_plugins; k++) {
         int rc = tcb_registry_load_plugin(cfg->plugins[k], err);
@@ -135,11 +135,9 @@ static int write_config(const run_state *st, tcb_error *err)
     return rc;
 }
 
-/* Synthetic: generate, normalize, sample pools. Objdir: the cached loader. */
-static int load_sequence(const run_state *st, const tcb_dataset_spec *d, const char *name,
-                         tcb_sequence *seq, tcb_error *err)
+int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, const char *name,
+                              tcb_sequence *seq, tcb_error *err)
 {
-    const tcb_config *cfg = st->cfg;
     int rc;
     if (d->source == TCB_SOURCE_SYNTHETIC) {
         rc = tcb_synth_generate(name, d->seed, d->frames, seq, err);
@@ -164,17 +162,23 @@ static int load_sequence(const run_state *st, const tcb_dataset_spec *d, const c
     return TCB_OK;
 }
 
-/* <splits_dir>/<dataset>/<sequence>.json; tcb_split_obtain refuses a file
- * made for other settings, so every method sees the same pairs. */
-static int obtain_split(const run_state *st, const tcb_dataset_spec *d,
-                        const tcb_sequence_spec *s, int n_frames, char *path, size_t size,
-                        tcb_split *split, tcb_error *err)
+int tcb_harness_obtain_split(const tcb_config *cfg, const tcb_dataset_spec *d,
+                             const tcb_sequence_spec *s, int n_frames, char *path, size_t size,
+                             tcb_split *split, tcb_error *err)
 {
-    const tcb_config *cfg = st->cfg;
     int rc = tcb_path_join(path, size, err, "%s/%s/%s.json", cfg->splits_dir, d->name, s->name);
     if (rc) return rc;
     return tcb_split_obtain(path, d->name, s->name, s->role, n_frames, cfg->eval_pairs,
                             cfg->split_seed, split, err);
+}
+
+int tcb_harness_work_paths(const char *run_dir, const char *dataset, const char *sequence,
+                           const char *label, int seed, char *work, char *ckpt, tcb_error *err)
+{
+    int rc = tcb_path_join(work, TCB_PATH_MAX, err, "%s/work/%s/%s/%s/seed_%d", run_dir, dataset,
+                           sequence, label, seed);
+    if (!rc) rc = tcb_path_join(ckpt, TCB_PATH_MAX, err, "%s/model.ckpt", work);
+    return rc;
 }
 
 /* An existing cell is reused only if it was made with the same method,
@@ -217,9 +221,8 @@ static int run_cell(const run_state *st, const seq_ctx *sc, const tcb_method_spe
                     const char *cell_path, tcb_error *err)
 {
     char work[TCB_PATH_MAX], ckpt[TCB_PATH_MAX];
-    int rc = tcb_path_join(work, sizeof work, err, "%s/work/%s/%s/%s/seed_%d", st->run_dir,
-                           sc->dataset->name, sc->seq->name, m->label, seed);
-    if (!rc) rc = tcb_path_join(ckpt, sizeof ckpt, err, "%s/model.ckpt", work);
+    int rc = tcb_harness_work_paths(st->run_dir, sc->dataset->name, sc->seq->name, m->label, seed,
+                                    work, ckpt, err);
     if (!rc) rc = tcb_mkdirs(work, err);
     if (rc) return rc;
     prepare_work_dir(work, st->opts->force);
@@ -290,10 +293,11 @@ static int run_sequence(const run_state *st, const tcb_dataset_spec *d, const tc
     char split_path[TCB_PATH_MAX];
     double t0 = tcb_now_seconds();
     tcb_report_log(&st->opts->reporter, TCB_LOG_INFO, "%s/%s: loading", d->name, s->name);
-    int rc = load_sequence(st, d, s->name, &seq, err);
+    int rc = tcb_harness_load_sequence(st->cfg, d, s->name, &seq, err);
     if (rc) return rc;
     seq_ctx sc = {d, &seq, &split, split_path, tcb_now_seconds() - t0};
-    rc = obtain_split(st, d, s, seq.n_frames, split_path, sizeof split_path, &split, err);
+    rc = tcb_harness_obtain_split(st->cfg, d, s, seq.n_frames, split_path, sizeof split_path,
+                                  &split, err);
     if (!rc) rc = run_cells(st, &sc, err);
     tcb_split_free(&split);
     tcb_sequence_free(&seq);
@@ -320,7 +324,7 @@ int tcb_run(const tcb_config *cfg, const tcb_run_opts *opts, tcb_run_stats *stat
 {
     memset(stats, 0, sizeof *stats);
     run_state st = {cfg, opts, opts->output ? opts->output : cfg->output, "", stats};
-    int rc = load_plugins(cfg, err);
+    int rc = tcb_harness_load_plugins(cfg, err);
     if (!rc) rc = check_methods(cfg, opts, err);
     if (!rc) rc = check_roots(cfg, err);
     if (!rc) rc = write_config(&st, err);

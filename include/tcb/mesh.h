@@ -1,4 +1,5 @@
-/* tcbench — one triangle mesh, and the Wavefront OBJ reader/writer.
+/* tcbench — one triangle mesh, the Wavefront OBJ reader/writer and a PLY
+ * writer for coloured meshes.
  *
  * The reader accepts `v x y z`, `f` with `v`, `v/vt`, `v//vn`, `v/vt/vn`
  * forms, negative (relative) indices, polygons (fan-triangulated) and
@@ -27,6 +28,11 @@ int tcb_obj_read(const char *path, tcb_mesh *out, tcb_error *err);
 /* Written atomically. */
 int tcb_obj_write(const char *path, const float *verts, int nv, const int32_t *faces,
                   int nf, tcb_error *err);
+/* A mesh (nf > 0) or point cloud (nf = 0, faces NULL) as ASCII PLY with
+ * optional per-vertex colours rgb [nv][3] (NULL: none); written atomically.
+ * (datasets/ply.c) */
+int tcb_ply_write(const char *path, const float *verts, int nv, const int32_t *faces, int nf,
+                  const uint8_t *rgb, tcb_error *err);
 void tcb_mesh_free(tcb_mesh *m);
 
 #ifdef __cplusplus

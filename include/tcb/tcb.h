@@ -19,6 +19,7 @@
 #include "tcb/results.h"
 #include "tcb/config.h"
 #include "tcb/runner.h"
+#include "tcb/inspect.h"
 #include "tcb/report.h"
 
 #define TCB_VERSION "0.1.0"

@@ -1,0 +1,26 @@
+/* A row of flat-shaded mesh views in one PNG (cairo), for `tcbench
+ * inspect`. Private to harness/. */
+#ifndef TCB_HARNESS_RENDER_H
+#define TCB_HARNESS_RENDER_H
+
+#include <stdint.h>
+
+#include "tcb/error.h"
+
+typedef struct tcb_render_panel {
+    const char *title;
+    const float *verts;   /* [nv][3] */
+    const uint8_t *rgb;   /* [nv][3] vertex colours; a face shows their mean */
+} tcb_render_panel;
+
+/* Panels of meshes sharing `faces` [nf][3] and vertex count nv, drawn side
+ * by side with one orthographic camera: looking along the axis in which
+ * `ref` [nv][3] is thinnest (the side of an animal), y up where y is not
+ * that axis, faces back to front, shaded by their slant to the viewer.
+ * With `colorbar_max` > 0 the last panel gets a viridis scale from 0 to
+ * it. Written atomically to `path`. */
+int tcb_render_panels(const char *path, const tcb_render_panel *panels, int n_panels, int nv,
+                      const int32_t *faces, int nf, const float *ref, double colorbar_max,
+                      tcb_error *err);
+
+#endif
