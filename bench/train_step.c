@@ -1,7 +1,7 @@
 /* One whole training iteration of the atlas family (tcb_atlas_train_step:
  * the batch drawn from the point pools, forward, the method's loss,
- * backward, Adam), for atlasnet (Chamfer, no tangents) and mca (Chamfer +
- * 0.1·L_mc, with the UV-Jacobians), at the paper's scale (C 1024, P 10,
+ * backward, Adam), for atlasnet (Chamfer, no tangents), dsr (Chamfer +
+ * 0.001·L_sciso) and mca (Chamfer + 0.1·L_mc; both with the UV-Jacobians), at the paper's scale (C 1024, P 10,
  * M 2500, N 2500) and the cpu preset's (C 256, P 10, M 1000, N 2500), beside
  * the same step in PyTorch on the CPU in the same run
  * (train_step_torch.py: tests/pytorch/atlas_torch.py's reference step,
@@ -55,7 +55,9 @@ static const struct {
     const char *name;
     tcb_atlas_loss loss;
     int nt; /* tangents per value */
-} methods[] = {{"atlasnet", TCB_ATLAS_LOSS_CHAMFER, 0}, {"mca", TCB_ATLAS_LOSS_METRIC, 2}};
+} methods[] = {{"atlasnet", TCB_ATLAS_LOSS_CHAMFER, 0},
+               {"dsr", TCB_ATLAS_LOSS_DSR, 2},
+               {"mca", TCB_ATLAS_LOSS_METRIC, 2}};
 
 typedef struct {
     int iters, threads, torch;
@@ -133,7 +135,7 @@ static void print_header(const options *o)
     printf("GFLOP/it = 2 x minimal multiply-adds of forward + backward (bench/atlas_bench.h):\n"
            "  encoder B*N*(3*64 + 64*128 + 128*C) + 2*B*C^2; per patch B*C*H1 + B*m*2*H1\n"
            "  + (1+nt)*B*m*(H1*H2 + H2*H3 + 3*H3), m = M/P, H1 = C+2, H2 = H1/2, H3 = H1/4,\n"
-           "  nt = 2 tangents (mca) or 0 (atlasnet); backward ~2x (exact count in the header);\n"
+           "  nt = 2 tangents (dsr, mca) or 0 (atlasnet); backward ~2x (exact count in the header);\n"
            "  loss and Adam not counted. Peak %.0f GFLOP/s.\n", o->peak);
     printf("%-6s %-9s %8s %9s %8s %6s %10s %8s %9s %9s\n", "preset", "method", "GFLOP/it",
            "C ms/it", "GFLOP/s", "%peak", "torch ms", "torch/C", "C RSS MiB", "torch MiB");
