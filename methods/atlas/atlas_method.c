@@ -3,7 +3,7 @@
  *
  * Presets (overridable key by key; the default is cpu):
  *   paper  C 1024, P 10, M 2500, 200,000 iterations (reference-protocol §4)
- *   cpu    C 256,  P 10, M 1000,  20,000 iterations (sized for 2 CPU cores)
+ *   cpu    C 256,  P 10, M 1000,  40,000 iterations (sized for 2 CPU cores)
  *   tiny   C 32,   P 4,  M 200,      300 iterations (tests)
  *
  * Two kinds of checkpoint. During fit, every `checkpoint_every` iterations
@@ -32,7 +32,7 @@ typedef struct atlas_preset {
 
 static const atlas_preset presets[] = {
     {1024, 10, 2500, 200000},
-    {256, 10, 1000, 20000},
+    {256, 10, 1000, 40000},
     {32, 4, 200, 300},
 };
 static const char *const preset_names[] = {"paper", "cpu", "tiny", NULL}; /* presets[k]; default cpu */
