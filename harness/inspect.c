@@ -33,20 +33,25 @@ typedef struct cell_row {
 static int resolve_sequence(const tcb_config *cfg, const char *want, target *t, tcb_error *err)
 {
     int n = 0;
+    char names[512] = ""; /* for the message; names that do not fit are left out */
     for (int a = 0; a < cfg->n_datasets; a++)
         for (int b = 0; b < cfg->datasets[a].n_sequences; b++) {
             const tcb_dataset_spec *d = &cfg->datasets[a];
             char name[TCB_PATH_MAX];
             snprintf(name, sizeof name, "%s/%s", d->name, d->sequences[b].name);
+            size_t used = strlen(names);
+            if (used + strlen(name) + 3 < sizeof names) {
+                if (used) strcat(names, ", ");
+                strcat(names, name);
+            }
             if (!want || strcmp(want, name) == 0) t->d = d, t->s = &d->sequences[b], n++;
         }
     if (n == 1) return TCB_OK;
     if (want)
-        return tcb_fail(err, TCB_ERR_INPUT, "%s: no sequence '%s' (give DATASET/SEQUENCE)",
-                        cfg->path, want);
-    return tcb_fail(err, TCB_ERR_INPUT,
-                    "%s has %d sequences: choose one with --sequence DATASET/SEQUENCE", cfg->path,
-                    n);
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: no sequence '%s' (the run's: %s)", cfg->path,
+                        want, names);
+    return tcb_fail(err, TCB_ERR_INPUT, "%s has %d sequences: choose one with --sequence (%s)",
+                    cfg->path, n, names);
 }
 
 static int resolve(const tcb_config *cfg, const tcb_inspect_opts *o, target *t, tcb_error *err)
