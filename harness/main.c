@@ -272,7 +272,8 @@ static const command commands[] = {
     {"report", cmd_report, BIT(F_OUT) | BIT(F_QUIET), 1, 1, "RUN_DIR",
      "usage: tcbench report RUN_DIR [--out DIR] [--quiet]\n"
      "\n"
-     "Writes tables.md, tables.tex, results.csv and PCK plots for a run directory and\n"
+     "Writes tables.md, tables.tex, results.csv, by_gap.csv, and per sequence the PCK\n"
+     "curves and m_sL2 by frame distance as PNG plots, for a run directory, and\n"
      "prints the Markdown tables.\n"
      "\n"
      "options:\n"

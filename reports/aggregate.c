@@ -29,8 +29,30 @@ static void set_stat(tcb_rpt_row *r, int m, const tcb_stat *s)
     r->std[m] = tcb_stat_std(s) * tcb_rpt_metrics[m].scale;
 }
 
+static int gap_of(const tcb_pair_record *p) { return p->i > p->j ? p->i - p->j : p->j - p->i; }
+
+/* The row's error by frame distance over its (ok) cells. */
+static int build_gaps(const tcb_cell_result *cells, int n, tcb_rpt_row *r, tcb_error *err)
+{
+    int max_gap = -1;
+    for (int k = 0; k < n; k++)
+        for (int p = 0; p < cells[k].n_pairs; p++)
+            if (gap_of(&cells[k].pairs[p]) > max_gap) max_gap = gap_of(&cells[k].pairs[p]);
+    if (max_gap < 0) return TCB_OK;
+    r->by_gap = calloc((size_t)max_gap + 1, sizeof *r->by_gap);
+    if (!r->by_gap) return tcb_fail(err, TCB_ERR_NOMEM, "report: out of memory");
+    r->n_gaps = max_gap + 1;
+    for (int k = 0; k < n; k++)
+        for (int p = 0; p < cells[k].n_pairs; p++) {
+            tcb_rpt_gap *g = &r->by_gap[gap_of(&cells[k].pairs[p])];
+            g->n_pairs++;
+            tcb_stat_merge(&g->sl2, &cells[k].pairs[p].sl2);
+        }
+    return TCB_OK;
+}
+
 /* cells[0 .. n): one method of one block, ascending seeds. */
-static void build_row(const tcb_cell_result *cells, int n, tcb_rpt_row *r)
+static int build_row(const tcb_cell_result *cells, int n, tcb_rpt_row *r, tcb_error *err)
 {
     memset(r, 0, sizeof *r);
     snprintf(r->method, sizeof r->method, "%s", cells[0].method);
@@ -58,7 +80,7 @@ static void build_row(const tcb_cell_result *cells, int n, tcb_rpt_row *r)
         else
             snprintf(r->status_text, sizeof r->status_text, "%s (%d/%d seeds)", r->status, n_bad,
                      n);
-        return;
+        return TCB_OK;
     }
     snprintf(r->status_text, sizeof r->status_text, "ok");
     set_stat(r, TCB_M_SL2, &pooled.sl2);
@@ -68,6 +90,7 @@ static void build_row(const tcb_cell_result *cells, int n, tcb_rpt_row *r)
     r->sl2sq_mean = pooled.sl2sq.mean * 1e3;
     r->sl2sq_std = tcb_stat_std(&pooled.sl2sq) * 1e3;
     for (int s = 0; s < TCB_PCK_STEPS; s++) r->pck[s] = pooled.pck[s] * 100.0;
+    return build_gaps(cells, n, r, err);
 }
 
 /* ------------------------------------------------------ best per column */
@@ -160,7 +183,8 @@ static int build_block(const tcb_cell_result *cells, int n, tcb_rpt_block *b, tc
     for (int k = 0; k < n;) {
         int e = k + 1;
         while (e < n && !strcmp(cells[e].method, cells[k].method)) e++;
-        build_row(cells + k, e - k, &b->rows[b->n_rows++]);
+        int rc = build_row(cells + k, e - k, &b->rows[b->n_rows++], err);
+        if (rc) return rc;
         k = e;
     }
     finish_block(b);
@@ -318,7 +342,10 @@ int tcb_rpt_load(const char *run_dir, tcb_rpt *out, tcb_error *err)
 
 void tcb_rpt_free(tcb_rpt *r)
 {
-    for (int k = 0; k < r->n_blocks; k++) free(r->blocks[k].rows);
+    for (int k = 0; k < r->n_blocks; k++) {
+        for (int i = 0; i < r->blocks[k].n_rows; i++) free(r->blocks[k].rows[i].by_gap);
+        free(r->blocks[k].rows);
+    }
     for (int k = 0; k < r->n_datasets; k++) free(r->datasets[k].mean.rows);
     free(r->blocks);
     free(r->datasets);

@@ -33,6 +33,13 @@ typedef struct tcb_rpt_metric_def {
 
 extern const tcb_rpt_metric_def tcb_rpt_metrics[TCB_N_METRICS];
 
+/* One frame distance |i − j| of a row: how its error grows with the time
+ * between the frames, which is what temporal coherence is about. */
+typedef struct tcb_rpt_gap {
+    int n_pairs;                      /* pairs at this distance, seeds pooled */
+    tcb_stat sl2;                     /* per-vertex Euclidean error, raw units */
+} tcb_rpt_gap;
+
 typedef struct tcb_rpt_row {
     char method[64];
     const char *status;               /* "ok", "failed", "diverged" or "missing" */
@@ -46,6 +53,8 @@ typedef struct tcb_rpt_row {
     double std[TCB_N_METRICS];        /* table units */
     double sl2sq_mean, sl2sq_std;     /* ×1e3; valid when has[TCB_M_SL2] */
     double pck[TCB_PCK_STEPS];        /* percent; valid when status is "ok" */
+    int n_gaps;                       /* largest |i − j| + 1; 0 unless ok, and in MEAN rows */
+    tcb_rpt_gap *by_gap;              /* malloc'ed [n_gaps], indexed by |i − j| */
 } tcb_rpt_row;
 
 typedef struct tcb_rpt_block {

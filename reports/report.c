@@ -1,7 +1,9 @@
-/* `tcbench report`: tables.md, tables.tex, results.csv and one PCK plot per
- * sequence, each published atomically. */
+/* `tcbench report`: tables.md, tables.tex, results.csv, by_gap.csv and two
+ * plots per sequence (PCK, m_sL2 by frame distance), each published
+ * atomically. */
 #include "tcb/report.h"
 
+#include "reports/chart.h"
 #include "reports/writers.h"
 #include "tcb/fsutil.h"
 
@@ -18,21 +20,29 @@ static int write_text(const char *dir, const char *name, text_writer w, const tc
     return tcb_atomic_commit(&af, err);
 }
 
+typedef int (*block_plot)(const tcb_rpt_block *b, const char *path, tcb_error *err);
+
+static int write_plot(const char *dir, const char *prefix, block_plot plot,
+                      const tcb_rpt_block *b, tcb_error *err)
+{
+    char name[TCB_PATH_MAX], path[TCB_PATH_MAX];
+    int rc = tcb_chart_file_name(b, prefix, name, sizeof name, err);
+    if (rc || (rc = tcb_path_join(path, sizeof path, err, "%s/%s", dir, name))) return rc;
+    return plot(b, path, err);
+}
+
 static int write_all(const tcb_rpt *r, const char *dir, tcb_error *err)
 {
     int rc = tcb_mkdirs(dir, err);
     if (rc || (rc = write_text(dir, "tables.md", tcb_rpt_write_md, r, err)) ||
         (rc = write_text(dir, "tables.tex", tcb_rpt_write_tex, r, err)) ||
-        (rc = write_text(dir, "results.csv", tcb_rpt_write_csv, r, err)))
+        (rc = write_text(dir, "results.csv", tcb_rpt_write_csv, r, err)) ||
+        (rc = write_text(dir, "by_gap.csv", tcb_rpt_write_gap_csv, r, err)))
         return rc;
-    for (int k = 0; k < r->n_blocks; k++) {
-        char name[TCB_PATH_MAX], path[TCB_PATH_MAX];
-        if ((rc = tcb_rpt_pck_name(&r->blocks[k], name, sizeof name, err)) ||
-            (rc = tcb_path_join(path, sizeof path, err, "%s/%s", dir, name)) ||
-            (rc = tcb_rpt_plot_pck(&r->blocks[k], path, err)))
-            return rc;
-    }
-    return TCB_OK;
+    for (int k = 0; k < r->n_blocks && !rc; k++)
+        if (!(rc = write_plot(dir, "pck", tcb_rpt_plot_pck, &r->blocks[k], err)))
+            rc = write_plot(dir, "gap", tcb_rpt_plot_gap, &r->blocks[k], err);
+    return rc;
 }
 
 int tcb_report_write(const char *run_dir, const char *out_dir, FILE *echo, tcb_error *err)

@@ -1,6 +1,9 @@
 /* results.csv: one row per (dataset, sequence, method), then each dataset's
  * MEAN rows (sequence "MEAN", role "mean"). Table units, the tables'
- * precision; empty fields where the tables show "-" or a status. */
+ * precision; empty fields where the tables show "-" or a status.
+ *
+ * by_gap.csv: one row per (dataset, sequence, method, frame distance) that
+ * has pairs, for the methods whose cells are all ok. */
 #include <string.h>
 
 #include "reports/writers.h"
@@ -25,13 +28,18 @@ static void put_num(FILE *f, int has, double x, int decimals)
     else fputc(',', f);
 }
 
-static void write_row(FILE *f, const tcb_rpt_block *b, const tcb_rpt_row *r)
+static void put_block(FILE *f, const tcb_rpt_block *b, const tcb_rpt_row *r)
 {
     put_field(f, b->dataset);
     fputc(',', f);
     put_field(f, b->sequence);
     fprintf(f, ",%s,", b->role);
     put_field(f, r->method);
+}
+
+static void write_row(FILE *f, const tcb_rpt_block *b, const tcb_rpt_row *r)
+{
+    put_block(f, b, r);
     fprintf(f, ",%s,%d,%d", r->status, r->n_seeds, r->n_pairs);
     for (int m = 0; m < TCB_N_METRICS; m++) {
         put_num(f, r->has[m], r->mean[m], tcb_rpt_metrics[m].decimals);
@@ -57,4 +65,21 @@ void tcb_rpt_write_csv(FILE *f, const tcb_rpt *r)
         for (int i = 0; ds->n_test && i < ds->mean.n_rows; i++)
             write_row(f, &ds->mean, &ds->mean.rows[i]);
     }
+}
+
+void tcb_rpt_write_gap_csv(FILE *f, const tcb_rpt *r)
+{
+    const tcb_rpt_metric_def *d = &tcb_rpt_metrics[TCB_M_SL2];
+    fputs("dataset,sequence,role,method,gap,n_pairs,n_vertices,sl2_x1e3_mean,sl2_x1e3_std\n", f);
+    for (int k = 0; k < r->n_blocks; k++)
+        for (int i = 0; i < r->blocks[k].n_rows; i++) {
+            const tcb_rpt_row *row = &r->blocks[k].rows[i];
+            for (int g = 0; g < row->n_gaps; g++) {
+                const tcb_rpt_gap *gap = &row->by_gap[g];
+                if (!gap->n_pairs) continue;
+                put_block(f, &r->blocks[k], row);
+                fprintf(f, ",%d,%d,%.0f,%.*f,%.*f\n", g, gap->n_pairs, gap->sl2.n, d->decimals,
+                        gap->sl2.mean * d->scale, d->decimals, tcb_stat_std(&gap->sl2) * d->scale);
+            }
+        }
 }

@@ -12,10 +12,12 @@
 void tcb_rpt_write_md(FILE *f, const tcb_rpt *r);   /* reports/table_md.c */
 void tcb_rpt_write_tex(FILE *f, const tcb_rpt *r);  /* reports/table_tex.c */
 void tcb_rpt_write_csv(FILE *f, const tcb_rpt *r);  /* reports/table_csv.c */
+/* by_gap.csv: each sequence row's m_sL2 per frame distance. (reports/table_csv.c) */
+void tcb_rpt_write_gap_csv(FILE *f, const tcb_rpt *r);
 
-/* pck_<dataset>_<sequence>.png, with characters outside [A-Za-z0-9._-] as '_'. */
-int tcb_rpt_pck_name(const tcb_rpt_block *b, char *out, size_t size, tcb_error *err);
-/* One PNG of the block's PCK curves, published atomically at `path`. (reports/plot_pck.c) */
+/* One PNG per block, published atomically at `path`: the PCK curves
+ * (reports/plot_pck.c) and m_sL2 by frame distance (reports/plot_gap.c). */
 int tcb_rpt_plot_pck(const tcb_rpt_block *b, const char *path, tcb_error *err);
+int tcb_rpt_plot_gap(const tcb_rpt_block *b, const char *path, tcb_error *err);
 
 #endif

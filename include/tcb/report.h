@@ -16,8 +16,10 @@
 extern "C" {
 #endif
 
-/* Writes <out_dir>/{tables.md, tables.tex, results.csv, pck_<dataset>_<sequence>.png}
- * (out_dir NULL → <run>/report) and echoes the Markdown tables to `echo` if non-NULL. */
+/* Writes <out_dir>/{tables.md, tables.tex, results.csv, by_gap.csv} and per
+ * sequence pck_<dataset>_<sequence>.png and gap_<dataset>_<sequence>.png
+ * (m_sL2 by frame distance |i − j|), out_dir NULL → <run>/report, and
+ * echoes the Markdown tables to `echo` if non-NULL. */
 int tcb_report_write(const char *run_dir, const char *out_dir, FILE *echo, tcb_error *err);
 
 /* Baseline file "tcbench-baseline/1": per (dataset, sequence, method) the four

@@ -54,6 +54,11 @@ static inline void fake_pair(const fake_cell *c, int p, tcb_pair_metrics *m)
     }
 }
 
+/* Pair p's frames: (0, 1) and (3, 1), frame distances 1 and 2 (both orders). */
+static inline int fake_i(int p) { return p ? 3 : 0; }
+static inline int fake_j(int p) { (void)p; return 1; }
+static inline int fake_gap(int p) { return p + 1; }
+
 /* Writes the cell to its place under `run`; returns 0 on success. */
 static inline int fake_write(const char *run, const fake_cell *c)
 {
@@ -79,7 +84,7 @@ static inline int fake_write(const char *run, const fake_cell *c)
             tcb_pair_metrics m;
             fake_pair(c, p, &m);
             double cd = c->has_cd ? fake_cd(c, p) : NAN;
-            pairs[p] = (tcb_pair_record){p, p + 1, m.sl2, m.sl2sq, m.rank, m.auc, cd};
+            pairs[p] = (tcb_pair_record){fake_i(p), fake_j(p), m.sl2, m.sl2sq, m.rank, m.auc, cd};
             tcb_summary_add_pair(&r.summary, &m, cd);
         }
     } else {

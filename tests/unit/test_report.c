@@ -244,8 +244,9 @@ typedef struct csv_row {
     char field[17][64];
 } csv_row;
 
-/* Plain comma splitting: the fake run's names need no CSV quoting. */
-static int parse_csv(const char *text, csv_row *rows, int max)
+/* Plain comma splitting: the fake run's names need no CSV quoting. Every
+ * line must have `n_fields` fields. */
+static int parse_csv(const char *text, int n_fields, csv_row *rows, int max)
 {
     int n = 0;
     for (const char *line = text; *line && n < max; n++) {
@@ -258,7 +259,7 @@ static int parse_csv(const char *text, csv_row *rows, int max)
             if (stop == end) break;
             p = stop + 1;
         }
-        assert_int_equal(f + 1, 17);
+        assert_int_equal(f + 1, n_fields);
         line = end + 1;
     }
     return n;
@@ -294,7 +295,7 @@ static void test_csv_parses_back(void **state)
     snprintf(path, sizeof path, "%s/results.csv", f->report);
     char *text = read_all(path);
     csv_row *rows = calloc(64, sizeof *rows);
-    int n = parse_csv(text, rows, 64);
+    int n = parse_csv(text, 17, rows, 64);
     /* header + 4 sequences × 3 methods + anim's 3 MEAN rows */
     assert_int_equal(n, 1 + 12 + 3);
     assert_string_equal(rows[0].field[7], "sl2_x1e3_mean");
@@ -314,6 +315,68 @@ static void test_csv_parses_back(void **state)
     r = find_csv(rows, n, "camel", "DSR");
     assert_string_equal(r->field[4], "failed");
     assert_string_equal(r->field[7], "");
+    free(rows);
+    free(text);
+}
+
+/* m_sL2 of (sequence, method) over the pairs at frame distance `gap`,
+ * seeds pooled, in table units, from the raw per-vertex errors. */
+static void expected_gap(int s, int m, int gap, double *mean, double *std, int *n_pairs)
+{
+    double sl2[8 * FAKE_PAIRS * FAKE_NV];
+    int nv = 0;
+    *n_pairs = 0;
+    for (int seed = 0; seed < METHODS[m].n_seeds; seed++) {
+        fake_cell c = cell_of(s, m, seed);
+        for (int p = 0; p < FAKE_PAIRS; p++) {
+            if (fake_gap(p) != gap) continue;
+            ++*n_pairs;
+            for (int k = 0; k < FAKE_NV; k++) sl2[nv++] = fake_sl2(&c, p, k);
+        }
+    }
+    fake_mean_std(sl2, nv, mean, std);
+    *mean *= 1e3, *std *= 1e3;
+}
+
+static const csv_row *find_gap(const csv_row *rows, int n, const char *seq, const char *method,
+                               int gap)
+{
+    for (int k = 1; k < n; k++)
+        if (!strcmp(rows[k].field[1], seq) && !strcmp(rows[k].field[3], method) &&
+            atoi(rows[k].field[4]) == gap)
+            return &rows[k];
+    return NULL;
+}
+
+static void test_gap_csv_by_frame_distance(void **state)
+{
+    fixture *f = *state;
+    char path[4096];
+    snprintf(path, sizeof path, "%s/by_gap.csv", f->report);
+    char *text = read_all(path);
+    csv_row *rows = calloc(64, sizeof *rows);
+    int n = parse_csv(text, 9, rows, 64);
+    assert_string_equal(rows[0].field[4], "gap");
+    /* 2 distances × (4 sequences × 3 methods − DSR failed on camel); no MEAN rows. */
+    assert_int_equal(n, 1 + 2 * (N_SEQS * N_METHODS - 1));
+    assert_null(find_gap(rows, n, "camel", "DSR", 1));
+    assert_null(find_gap(rows, n, "MEAN", "AN", 1));
+    for (int s = 0; s < N_SEQS; s++)
+        for (int m = 0; m < N_METHODS; m++)
+            for (int gap = 1; gap <= 2; gap++) {
+                const csv_row *r = find_gap(rows, n, SEQS[s].name, METHODS[m].name, gap);
+                if (!r) continue;
+                double mean, std;
+                int n_pairs;
+                expected_gap(s, m, gap, &mean, &std, &n_pairs);
+                assert_string_equal(r->field[2], SEQS[s].role);
+                assert_int_equal(atoi(r->field[5]), n_pairs);
+                assert_int_equal(atoi(r->field[6]), n_pairs * FAKE_NV);
+                assert_true(fabs(strtod(r->field[7], NULL) - mean) <= 0.005 + 1e-12);
+                assert_true(fabs(strtod(r->field[8], NULL) - std) <= 0.005 + 1e-12);
+            }
+    /* Two seeds of AN pooled: both pairs at distance 2. */
+    assert_string_equal(find_gap(rows, n, "horse", "AN", 2)->field[5], "2");
     free(rows);
     free(text);
 }
@@ -346,9 +409,10 @@ static void test_pngs_are_valid(void **state)
 {
     fixture *f = *state;
     static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    for (int s = 0; s < N_SEQS; s++) {
+    for (int s = 0; s < 2 * N_SEQS; s++) {
         char path[4096];
-        snprintf(path, sizeof path, "%s/pck_%s_%s.png", f->report, SEQS[s].dataset, SEQS[s].name);
+        snprintf(path, sizeof path, "%s/%s_%s_%s.png", f->report, s < N_SEQS ? "pck" : "gap",
+                 SEQS[s % N_SEQS].dataset, SEQS[s % N_SEQS].name);
         FILE *fp = fopen(path, "rb");
         assert_non_null(fp);
         unsigned char head[24];
@@ -369,7 +433,7 @@ static void test_pngs_are_valid(void **state)
         n++;
     }
     closedir(d);
-    assert_int_equal(n, 3 + N_SEQS);
+    assert_int_equal(n, 4 + 2 * N_SEQS);
 }
 
 static void test_empty_run_is_an_error(void **state)
@@ -398,6 +462,7 @@ int main(void)
         cmocka_unit_test(test_md_failed_method_shows_status),
         cmocka_unit_test(test_md_mean_over_test_sequences_only),
         cmocka_unit_test(test_csv_parses_back),
+        cmocka_unit_test(test_gap_csv_by_frame_distance),
         cmocka_unit_test(test_tex_uses_booktabs),
         cmocka_unit_test(test_pngs_are_valid),
     };

@@ -1,0 +1,235 @@
+/* The shared plot frame of the reports (cairo); see chart.h. */
+#include "reports/chart.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "tcb/fsutil.h"
+
+enum { W = 900, H = 600 };
+/* Plot area in device pixels. */
+static const double X0 = 84, X1 = 650, Y0 = 78, Y1 = 516;
+static const double LEGEND_X = 676, LEGEND_W = 210;
+static const char *const FONT = "DejaVu Sans";
+
+/* d3 category10: distinct hues that stay readable on white. */
+static const double PALETTE[][3] = {
+    {0.122, 0.467, 0.706}, {1.000, 0.498, 0.055}, {0.173, 0.627, 0.173}, {0.839, 0.153, 0.157},
+    {0.580, 0.404, 0.741}, {0.549, 0.337, 0.294}, {0.890, 0.467, 0.761}, {0.498, 0.498, 0.498},
+    {0.737, 0.741, 0.133}, {0.090, 0.745, 0.812},
+};
+#define N_COLOURS ((int)(sizeof PALETTE / sizeof PALETTE[0]))
+
+double tcb_chart_px(const tcb_chart *c, double x) { return X0 + (X1 - X0) * x / c->x.max; }
+double tcb_chart_py(const tcb_chart *c, double y) { return Y1 - (Y1 - Y0) * y / c->y.max; }
+
+static void font(cairo_t *cr, double size, int bold)
+{
+    cairo_select_font_face(cr, FONT, CAIRO_FONT_SLANT_NORMAL,
+                           bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
+    cairo_set_font_size(cr, size);
+}
+
+/* Text anchored at (x, y) on its baseline; align 0 left, 0.5 centre, 1 right. */
+static void text(cairo_t *cr, double x, double y, double align, const char *s)
+{
+    cairo_text_extents_t e;
+    cairo_text_extents(cr, s, &e);
+    cairo_move_to(cr, x - align * e.x_advance, y);
+    cairo_show_text(cr, s);
+}
+
+static void tick_label(const tcb_chart_axis *a, int k, char *out, size_t size)
+{
+    if (k == 0) snprintf(out, size, "0");
+    else snprintf(out, size, a->format, a->max * k / a->n_ticks);
+}
+
+static void draw_x_ticks(tcb_chart *c)
+{
+    cairo_t *cr = c->cr;
+    for (int k = 0; k <= c->x.n_ticks; k++) {
+        double x = round(tcb_chart_px(c, c->x.max * k / c->x.n_ticks)) + 0.5;
+        char label[32];
+        cairo_set_source_rgb(cr, 0.90, 0.90, 0.90);
+        cairo_move_to(cr, x, Y0);
+        cairo_line_to(cr, x, Y1);
+        cairo_stroke(cr);
+        cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
+        cairo_move_to(cr, x, Y1);
+        cairo_line_to(cr, x, Y1 + 6);
+        cairo_stroke(cr);
+        tick_label(&c->x, k, label, sizeof label);
+        text(cr, x, Y1 + 24, 0.5, label);
+    }
+}
+
+static void draw_y_ticks(tcb_chart *c)
+{
+    cairo_t *cr = c->cr;
+    for (int k = 0; k <= c->y.n_ticks; k++) {
+        double y = round(tcb_chart_py(c, c->y.max * k / c->y.n_ticks)) + 0.5;
+        char label[32];
+        cairo_set_source_rgb(cr, 0.90, 0.90, 0.90);
+        cairo_move_to(cr, X0, y);
+        cairo_line_to(cr, X1, y);
+        cairo_stroke(cr);
+        cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
+        cairo_move_to(cr, X0 - 6, y);
+        cairo_line_to(cr, X0, y);
+        cairo_stroke(cr);
+        tick_label(&c->y, k, label, sizeof label);
+        text(cr, X0 - 10, y + 5, 1, label);
+    }
+}
+
+void tcb_chart_begin(tcb_chart *c, const tcb_chart_axis *x, const tcb_chart_axis *y)
+{
+    c->x = *x, c->y = *y;
+    c->surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H);
+    c->cr = cairo_create(c->surface);
+    cairo_t *cr = c->cr;
+    cairo_set_source_rgb(cr, 1, 1, 1);
+    cairo_paint(cr);
+    cairo_set_line_width(cr, 1);
+    font(cr, 13, 0);
+    draw_x_ticks(c);
+    draw_y_ticks(c);
+    cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
+    cairo_rectangle(cr, X0 + 0.5, Y0 + 0.5, X1 - X0 - 1, Y1 - Y0 - 1);
+    cairo_stroke(cr);
+    font(cr, 14, 0);
+    text(cr, (X0 + X1) / 2, Y1 + 54, 0.5, x->label);
+    cairo_save(cr);
+    cairo_translate(cr, X0 - 52, (Y0 + Y1) / 2);
+    cairo_rotate(cr, -M_PI / 2);
+    text(cr, 0, 0, 0.5, y->label);
+    cairo_restore(cr);
+}
+
+static void set_style(cairo_t *cr, int k)
+{
+    const double *rgb = PALETTE[k % N_COLOURS];
+    cairo_set_source_rgb(cr, rgb[0], rgb[1], rgb[2]);
+    cairo_set_line_width(cr, 2.2);
+    /* Past ten methods the colours repeat; dashes keep the lines apart. */
+    static const double dash[] = {7, 4};
+    cairo_set_dash(cr, dash, k >= N_COLOURS ? 2 : 0, 0);
+}
+
+void tcb_chart_series_begin(tcb_chart *c, int k)
+{
+    cairo_save(c->cr);
+    /* A line at exactly the axis end must stay visible, not be half clipped. */
+    cairo_rectangle(c->cr, X0, Y0 - 2, X1 - X0, Y1 - Y0 + 2);
+    cairo_clip(c->cr);
+    cairo_set_line_join(c->cr, CAIRO_LINE_JOIN_ROUND);
+    set_style(c->cr, k);
+}
+
+void tcb_chart_series_end(tcb_chart *c) { cairo_restore(c->cr); }
+
+/* The label fitted to `width`, ellipsized at a UTF-8 boundary when too long. */
+static void fit_label(cairo_t *cr, char *s, size_t size, double width)
+{
+    cairo_text_extents_t e;
+    size_t n = strlen(s);
+    cairo_text_extents(cr, s, &e);
+    while (e.x_advance > width && n > 1) {
+        do n--; while (n > 0 && ((unsigned char)s[n] & 0xC0) == 0x80);
+        if (n + sizeof "…" > size) continue;
+        memcpy(s + n, "…", sizeof "…");
+        cairo_text_extents(cr, s, &e);
+    }
+}
+
+void tcb_chart_legend(tcb_chart *c, const tcb_rpt_block *b, const char *heading, int metric)
+{
+    cairo_t *cr = c->cr;
+    double y = Y0 + 8;
+    font(cr, 13, 1);
+    cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
+    text(cr, LEGEND_X, y + 4, 0, heading);
+    y += 28;
+    /* Many methods close ranks rather than run off the image. */
+    double step = fmin(24.0, (H - 16 - y) / (b->n_rows > 0 ? b->n_rows : 1));
+    for (int k = 0; k < b->n_rows; k++, y += step) {
+        const tcb_rpt_row *r = &b->rows[k];
+        char label[160];
+        if (!strcmp(r->status, "ok")) {
+            set_style(cr, k);
+            cairo_move_to(cr, LEGEND_X, y);
+            cairo_line_to(cr, LEGEND_X + 28, y);
+            cairo_stroke(cr);
+            snprintf(label, sizeof label, "%s (%.*f)", r->method,
+                     tcb_rpt_metrics[metric].decimals, r->mean[metric]);
+            cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
+        } else {
+            snprintf(label, sizeof label, "%s: %s", r->method, r->status_text);
+            cairo_set_source_rgb(cr, 0.55, 0.55, 0.55);
+        }
+        font(cr, 13, 0);
+        fit_label(cr, label, sizeof label, LEGEND_W - 36);
+        text(cr, LEGEND_X + 36, y + 5, 0, label);
+    }
+}
+
+void tcb_chart_title(tcb_chart *c, const tcb_rpt_block *b, const char *what)
+{
+    cairo_t *cr = c->cr;
+    char s[512];
+    cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+    font(cr, 19, 1);
+    snprintf(s, sizeof s, "%s — %s / %s", what, b->dataset, b->sequence);
+    text(cr, X0, 36, 0, s);
+    font(cr, 13, 0);
+    cairo_set_source_rgb(cr, 0.38, 0.38, 0.38);
+    if (b->n_pairs_min == b->n_pairs_max)
+        snprintf(s, sizeof s, "%s sequence · %d pairs · seeds %s", b->role, b->n_pairs_min,
+                 b->seeds);
+    else
+        snprintf(s, sizeof s, "%s sequence · %d–%d pairs · seeds %s", b->role, b->n_pairs_min,
+                 b->n_pairs_max, b->seeds);
+    text(cr, X0, 58, 0, s);
+}
+
+int tcb_chart_finish(tcb_chart *c, const char *path, tcb_error *err)
+{
+    char tmp[TCB_PATH_MAX];
+    cairo_status_t st = cairo_status(c->cr);
+    cairo_destroy(c->cr);
+    int rc = tcb_temp_path_for(path, tmp, sizeof tmp, err);
+    if (!rc && st == CAIRO_STATUS_SUCCESS) st = cairo_surface_write_to_png(c->surface, tmp);
+    cairo_surface_destroy(c->surface);
+    c->cr = NULL, c->surface = NULL;
+    if (rc) return rc;
+    if (st != CAIRO_STATUS_SUCCESS) {
+        unlink(tmp);
+        return tcb_fail(err, TCB_ERR_IO, "%s: cannot draw the plot: %s", path,
+                        cairo_status_to_string(st));
+    }
+    return tcb_publish(tmp, path, err);
+}
+
+int tcb_chart_file_name(const tcb_rpt_block *b, const char *prefix, char *out, size_t size,
+                        tcb_error *err)
+{
+    int rc = tcb_path_join(out, size, err, "%s_%s_%s.png", prefix, b->dataset, b->sequence);
+    for (char *p = out; !rc && *p; p++) {
+        int ok = (*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9') ||
+                 *p == '_' || *p == '-' || *p == '.';
+        if (!ok) *p = '_';
+    }
+    return rc;
+}
+
+double tcb_chart_nice_ceil(double v)
+{
+    double p = pow(10.0, floor(log10(v)));
+    static const double steps[] = {1.0, 2.0, 2.5, 5.0, 10.0};
+    for (size_t k = 0; k < sizeof steps / sizeof steps[0]; k++)
+        if (steps[k] * p >= v * (1.0 - 1e-12)) return steps[k] * p;
+    return 10.0 * p;
+}

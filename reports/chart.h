@@ -1,0 +1,61 @@
+/* Private to reports/: the frame every report plot shares, so that a plot
+ * file only maps its data. A 900×600 PNG: axes from 0 with a light grid, a
+ * legend panel right of the axes (it can never hide a curve), a title with
+ * the block's role, pairs and seeds, and one style per method row that is
+ * the same in every plot of a block.
+ *
+ * Use: tcb_chart_begin, then for each series tcb_chart_series_begin …
+ * cairo drawing at (tcb_chart_px, tcb_chart_py) … tcb_chart_series_end,
+ * then tcb_chart_legend, tcb_chart_title and tcb_chart_finish, which
+ * publishes the file atomically and frees the chart whatever happened. */
+#ifndef TCB_REPORTS_CHART_H
+#define TCB_REPORTS_CHART_H
+
+#include <cairo.h>
+
+#include "reports/aggregate.h"
+#include "tcb/error.h"
+
+typedef struct tcb_chart_axis {
+    double max;          /* the axis runs 0 … max */
+    int n_ticks;         /* labelled ticks at max·k / n_ticks, k = 0 … n_ticks */
+    const char *format;  /* printf format of a tick value ("%.3f"); 0 prints "0" */
+    const char *label;
+} tcb_chart_axis;
+
+typedef struct tcb_chart {
+    cairo_surface_t *surface;
+    cairo_t *cr;
+    tcb_chart_axis x, y;
+} tcb_chart;
+
+/* A white canvas with the axes drawn. */
+void tcb_chart_begin(tcb_chart *c, const tcb_chart_axis *x, const tcb_chart_axis *y);
+
+/* Device coordinates of a data value. */
+double tcb_chart_px(const tcb_chart *c, double x);
+double tcb_chart_py(const tcb_chart *c, double y);
+
+/* Clip to the plot area and take row k's colour, width and dash. */
+void tcb_chart_series_begin(tcb_chart *c, int k);
+void tcb_chart_series_end(tcb_chart *c);
+
+/* One legend entry per row: "method (value)" with row r's mean of `metric`
+ * for ok rows, "method: status" in grey otherwise. */
+void tcb_chart_legend(tcb_chart *c, const tcb_rpt_block *b, const char *heading, int metric);
+
+/* "<what> — dataset / sequence" and the block's role, pairs and seeds. */
+void tcb_chart_title(tcb_chart *c, const tcb_rpt_block *b, const char *what);
+
+/* Writes the PNG to a temporary beside `path` and renames it into place. */
+int tcb_chart_finish(tcb_chart *c, const char *path, tcb_error *err);
+
+/* "<prefix>_<dataset>_<sequence>.png" with characters outside
+ * [A-Za-z0-9._-] as '_'. */
+int tcb_chart_file_name(const tcb_rpt_block *b, const char *prefix, char *out, size_t size,
+                        tcb_error *err);
+
+/* The smallest of 1, 2, 2.5, 5 × 10^k that is ≥ v (v > 0): a round axis end. */
+double tcb_chart_nice_ceil(double v);
+
+#endif
