@@ -2,6 +2,7 @@
  * block per dataset over its test sequences. */
 #include <string.h>
 
+#include "reports/chart.h"
 #include "reports/writers.h"
 
 static void pairs_text(const tcb_rpt_block *b, char *out, size_t size)
@@ -40,6 +41,17 @@ static void write_table(FILE *f, const tcb_rpt_block *b)
     fprintf(f, "\n");
 }
 
+/* The block's plots, written beside tables.md by the report. */
+static void write_plot_links(FILE *f, const tcb_rpt_block *b)
+{
+    char pck[1024], gap[1024];
+    tcb_error err = {0};
+    if (tcb_chart_file_name(b, "pck", pck, sizeof pck, &err) ||
+        tcb_chart_file_name(b, "gap", gap, sizeof gap, &err))
+        return; /* a name too long for a link: the plots are still in the directory */
+    fprintf(f, "![PCK curves](%s) ![m_sL2 by frame distance](%s)\n\n", pck, gap);
+}
+
 static void write_dataset(FILE *f, const tcb_rpt *r, const tcb_rpt_dataset *d)
 {
     fprintf(f, "## %s\n\n", d->name);
@@ -50,6 +62,7 @@ static void write_dataset(FILE *f, const tcb_rpt *r, const tcb_rpt_dataset *d)
         fprintf(f, "### %s / %s\n\nrole: %s · pairs: %s · seeds: %s\n\n", d->name, b->sequence,
                 b->role, pairs, b->seeds);
         write_table(f, b);
+        write_plot_links(f, b);
     }
     if (!d->n_test) {
         fprintf(f, "### %s / MEAN\n\nNo test sequence in this run: no MEAN block.\n\n", d->name);

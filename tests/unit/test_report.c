@@ -200,6 +200,9 @@ static void test_md_sequence_block_bold_and_dash(void **state)
     md_row("DSR", &dsr, 0xF, 0, row, sizeof row);
     assert_contains(horse, row);
     assert_contains(horse, "role: test · pairs: 2 · seeds: 0, 1");
+    /* Links to the block's plots, which test_pngs_are_valid finds on disk. */
+    assert_contains(horse, "![PCK curves](pck_anim_horse.png) "
+                           "![m_sL2 by frame distance](gap_anim_horse.png)");
     free(horse);
 }
 
