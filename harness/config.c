@@ -25,7 +25,7 @@ static const char *const synthetic_keys[] = {"name", "source", "seed", "frames",
 static const char *const objdir_keys[] = {"name", "source", "root", "optional", "normalization",
                                           "sampling", "sequences", NULL};
 static const char *const sequence_keys[] = {"name", "role", NULL};
-static const char *const method_keys[] = {"name", "method", "params", NULL};
+static const char *const method_keys[] = {"name", "method", "params", "seeds", NULL};
 
 const char *const tcb_config_source_names[] = {"synthetic", "objdir", NULL};
 const char *const tcb_config_norm_names[] = {"none", "first_frame", "per_frame", NULL};
@@ -172,7 +172,52 @@ static int parse_dataset(const cJSON *o, const char *where, tcb_dataset_spec *d,
     return parse_sequences(o, where, d, err);
 }
 
-static int parse_method(const cJSON *o, const char *where, tcb_method_spec *m, tcb_error *err)
+/* The distinct non-negative seeds of `arr`; `where` names the list
+ * ("t.json: seeds", "t.json: methods[1].seeds"). */
+static int parse_seed_list(const cJSON *arr, const char *where, int **seeds, int *n_seeds,
+                           tcb_error *err)
+{
+    int n = cJSON_GetArraySize(arr);
+    if (n == 0) return tcb_fail(err, TCB_ERR_INPUT, "%s: must list at least one seed", where);
+    *seeds = calloc((size_t)n, sizeof **seeds);
+    if (!*seeds) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", where);
+    *n_seeds = n;
+    for (int k = 0; k < n; k++) {
+        const cJSON *s = cJSON_GetArrayItem(arr, k);
+        double v = cJSON_IsNumber(s) ? s->valuedouble : -1;
+        if (v < 0 || v > INT_MAX || v != floor(v))
+            return tcb_fail(err, TCB_ERR_INPUT,
+                            "%s[%d]: expected a non-negative integer below 2^31", where, k);
+        (*seeds)[k] = (int)v;
+        for (int m = 0; m < k; m++)
+            if ((*seeds)[m] == (*seeds)[k])
+                return tcb_fail(err, TCB_ERR_INPUT, "%s[%d]: duplicate seed %d", where, k,
+                                (*seeds)[k]);
+    }
+    return TCB_OK;
+}
+
+/* The method's own "seeds", else a copy of the config's. */
+static int parse_method_seeds(const cJSON *o, const char *where, const tcb_config *c,
+                              tcb_method_spec *m, tcb_error *err)
+{
+    const cJSON *arr;
+    int rc = get_array(o, "seeds", where, 0, &arr, err);
+    if (rc) return rc;
+    if (arr) {
+        char w[WHERE_MAX + 8]; /* where + ".seeds" */
+        snprintf(w, sizeof w, "%s.seeds", where);
+        return parse_seed_list(arr, w, &m->seeds, &m->n_seeds, err);
+    }
+    m->seeds = malloc((size_t)c->n_seeds * sizeof *m->seeds);
+    if (!m->seeds) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", where);
+    memcpy(m->seeds, c->seeds, (size_t)c->n_seeds * sizeof *m->seeds);
+    m->n_seeds = c->n_seeds;
+    return TCB_OK;
+}
+
+static int parse_method(const cJSON *o, const char *where, const tcb_config *c,
+                        tcb_method_spec *m, tcb_error *err)
 {
     const char *label, *impl;
     int rc = tcb_json_expect_keys(o, where, method_keys, err);
@@ -189,7 +234,7 @@ static int parse_method(const cJSON *o, const char *where, tcb_method_spec *m, t
     /* The method itself validates the keys when it is created. */
     m->params_json = params ? cJSON_PrintUnformatted(params) : strdup("{}");
     if (!m->params_json) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", where);
-    return TCB_OK;
+    return parse_method_seeds(o, where, c, m, err);
 }
 
 static int parse_datasets(const cJSON *root, const char *origin, tcb_config *c, tcb_error *err)
@@ -233,7 +278,7 @@ static int parse_methods(const cJSON *root, const char *origin, tcb_config *c, t
     if (!c->methods) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", origin);
     for (int k = 0; k < n; k++) {
         snprintf(w, sizeof w, "%s: methods[%d]", origin, k);
-        rc = parse_method(cJSON_GetArrayItem(arr, k), w, &c->methods[k], err);
+        rc = parse_method(cJSON_GetArrayItem(arr, k), w, c, &c->methods[k], err);
         c->n_methods = k + 1;
         if (rc) return rc;
         for (int m = 0; m < k; m++)
@@ -247,29 +292,19 @@ static int parse_methods(const cJSON *root, const char *origin, tcb_config *c, t
 
 static int parse_seeds(const cJSON *root, const char *origin, tcb_config *c, tcb_error *err)
 {
-    char top[WHERE_MAX];
+    char top[WHERE_MAX], w[WHERE_MAX];
     snprintf(top, sizeof top, "%s:", origin);
     const cJSON *arr;
     int rc = fix_top(get_array(root, "seeds", top, 0, &arr, err), origin, err);
     if (rc) return rc;
-    int n = arr ? cJSON_GetArraySize(arr) : 1;
-    if (n == 0) return tcb_fail(err, TCB_ERR_INPUT, "%s: seeds: must list at least one seed", origin);
-    c->seeds = calloc((size_t)n, sizeof *c->seeds);
-    if (!c->seeds) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", origin);
-    c->n_seeds = n;
-    for (int k = 0; arr && k < n; k++) {
-        const cJSON *s = cJSON_GetArrayItem(arr, k);
-        double v = cJSON_IsNumber(s) ? s->valuedouble : -1;
-        if (v < 0 || v > INT_MAX || v != floor(v))
-            return tcb_fail(err, TCB_ERR_INPUT,
-                            "%s: seeds[%d]: expected a non-negative integer below 2^31", origin, k);
-        c->seeds[k] = (int)v;
-        for (int m = 0; m < k; m++)
-            if (c->seeds[m] == c->seeds[k])
-                return tcb_fail(err, TCB_ERR_INPUT, "%s: seeds[%d]: duplicate seed %d", origin, k,
-                                c->seeds[k]);
+    if (!arr) { /* default: the single seed 0 */
+        c->seeds = calloc(1, sizeof *c->seeds);
+        if (!c->seeds) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", origin);
+        c->n_seeds = 1;
+        return TCB_OK;
     }
-    return TCB_OK;
+    snprintf(w, sizeof w, "%s: seeds", origin);
+    return parse_seed_list(arr, w, &c->seeds, &c->n_seeds, err);
 }
 
 static int parse_plugins(const cJSON *root, const char *origin, tcb_config *c, tcb_error *err)
@@ -395,7 +430,10 @@ void tcb_config_free(tcb_config *c)
     free(c->seeds);
     for (int k = 0; k < c->n_datasets; k++) free(c->datasets[k].sequences);
     free(c->datasets);
-    for (int k = 0; k < c->n_methods; k++) free(c->methods[k].params_json);
+    for (int k = 0; k < c->n_methods; k++) {
+        free(c->methods[k].params_json);
+        free(c->methods[k].seeds);
+    }
     free(c->methods);
     free(c->json_text);
     memset(c, 0, sizeof *c);

@@ -1,6 +1,7 @@
 /* The normalized config: what was actually run, every default spelled out,
  * saved as <run>/config.json so a results directory documents itself. */
 #include <cjson/cJSON.h>
+#include <string.h>
 
 #include "harness/internal.h"
 
@@ -39,13 +40,23 @@ static cJSON *dump_dataset(const tcb_dataset_spec *d)
     return o;
 }
 
-static cJSON *dump_method(const tcb_method_spec *m)
+static cJSON *seed_array(const int *seeds, int n)
+{
+    cJSON *a = cJSON_CreateArray();
+    for (int k = 0; k < n; k++) cJSON_AddItemToArray(a, cJSON_CreateNumber(seeds[k]));
+    return a;
+}
+
+static cJSON *dump_method(const tcb_method_spec *m, const tcb_config *c)
 {
     cJSON *o = cJSON_CreateObject();
     cJSON_AddStringToObject(o, "name", m->label);
     cJSON_AddStringToObject(o, "method", m->method);
     cJSON *params = cJSON_Parse(m->params_json); /* printed by cJSON: always valid */
     cJSON_AddItemToObject(o, "params", params ? params : cJSON_CreateObject());
+    int own = m->n_seeds != c->n_seeds ||
+              memcmp(m->seeds, c->seeds, (size_t)c->n_seeds * sizeof *c->seeds) != 0;
+    if (own) cJSON_AddItemToObject(o, "seeds", seed_array(m->seeds, m->n_seeds));
     return o;
 }
 
@@ -60,15 +71,14 @@ char *tcb_config_normalized_json(const tcb_config *c)
     cJSON *plugins = cJSON_AddArrayToObject(o, "plugins");
     for (int k = 0; k < c->n_plugins; k++)
         cJSON_AddItemToArray(plugins, cJSON_CreateString(c->plugins[k]));
-    cJSON *seeds = cJSON_AddArrayToObject(o, "seeds");
-    for (int k = 0; k < c->n_seeds; k++) cJSON_AddItemToArray(seeds, cJSON_CreateNumber(c->seeds[k]));
+    cJSON_AddItemToObject(o, "seeds", seed_array(c->seeds, c->n_seeds));
     cJSON_AddNumberToObject(o, "threads", c->threads);
     cJSON_AddItemToObject(o, "evaluation", dump_evaluation(c));
     cJSON *datasets = cJSON_AddArrayToObject(o, "datasets");
     for (int k = 0; k < c->n_datasets; k++)
         cJSON_AddItemToArray(datasets, dump_dataset(&c->datasets[k]));
     cJSON *methods = cJSON_AddArrayToObject(o, "methods");
-    for (int k = 0; k < c->n_methods; k++) cJSON_AddItemToArray(methods, dump_method(&c->methods[k]));
+    for (int k = 0; k < c->n_methods; k++) cJSON_AddItemToArray(methods, dump_method(&c->methods[k], c));
     char *text = cJSON_Print(o);
     cJSON_Delete(o);
     return text;

@@ -65,11 +65,11 @@ static int resolve(const tcb_config *cfg, const tcb_inspect_opts *o, target *t, 
     if (!tcb_registry_find(t->m->method))
         return tcb_fail(err, TCB_ERR_INPUT, "%s: method '%s' is not registered (a plug-in?)",
                         cfg->path, t->m->method);
-    t->seed = o->seed >= 0 ? o->seed : cfg->seeds[0];
-    for (int k = 0; k < cfg->n_seeds; k++)
-        if (cfg->seeds[k] == t->seed) return TCB_OK;
-    return tcb_fail(err, TCB_ERR_INPUT, "%s: seed %d is not one of the run's seeds", cfg->path,
-                    t->seed);
+    t->seed = o->seed >= 0 ? o->seed : t->m->seeds[0];
+    for (int k = 0; k < t->m->n_seeds; k++)
+        if (t->m->seeds[k] == t->seed) return TCB_OK;
+    return tcb_fail(err, TCB_ERR_INPUT, "%s: seed %d is not one of %s's seeds in this run",
+                    cfg->path, t->seed, t->m->label);
 }
 
 static void load_cell_row(const char *run_dir, const target *t, int k, cell_row *row)

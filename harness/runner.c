@@ -268,16 +268,16 @@ static int run_cells(const run_state *st, const seq_ctx *sc, tcb_error *err)
     for (int k = 0; k < cfg->n_methods; k++) {
         const tcb_method_spec *m = &cfg->methods[k];
         if (!selected(st->opts, m)) continue;
-        for (int s = 0; s < cfg->n_seeds; s++) {
+        for (int s = 0; s < m->n_seeds; s++) {
             char path[TCB_PATH_MAX];
             int rc = tcb_cell_path(path, sizeof path, st->run_dir, sc->dataset->name,
-                                   sc->seq->name, m->label, cfg->seeds[s], err);
+                                   sc->seq->name, m->label, m->seeds[s], err);
             st->stats->cells_total++;
             if (!rc && !st->opts->force && tcb_is_file(path)) {
                 rc = check_existing(path, m, sc->split, err);
                 if (!rc) st->stats->cells_skipped++;
             } else if (!rc) {
-                rc = run_cell(st, sc, m, cfg->seeds[s], path, err);
+                rc = run_cell(st, sc, m, m->seeds[s], path, err);
             }
             if (rc) return rc;
         }

@@ -17,7 +17,8 @@
  *         "root": "../shared/data/anim", objdir sources only: <root>/<sequence>/
  *         "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
  *     "methods": [ { "name": "oracle" },
- *                  { "name": "mca-cpu", "method": "mca", "params": { … } } ] }
+ *                  { "name": "mca-cpu", "method": "mca", "params": { … },
+ *                    "seeds": [0, 1, 2] } ] }    its own seeds instead of the config's
  * Unknown keys anywhere are errors. */
 #ifndef TCB_CONFIG_H
 #define TCB_CONFIG_H
@@ -57,6 +58,8 @@ typedef struct tcb_method_spec {
     char label[64];          /* "name": unique within the config, used in results */
     char method[64];         /* registered method ("method", default = label) */
     char *params_json;       /* compact JSON object text, "{}" by default */
+    int n_seeds;             /* the cells to run: the method's "seeds", else the config's */
+    int *seeds;
 } tcb_method_spec;
 
 typedef struct tcb_config {

@@ -108,7 +108,7 @@ expect_fail() { # expected-message command...
 }
 expect_fail "no pair 6 (the split has 6: 0 to 5)" "$TCBENCH" inspect run nearest 6 --out bad --quiet
 expect_fail "no method labelled 'mca'" "$TCBENCH" inspect run mca 0 --out bad --quiet
-expect_fail "seed 7 is not one of the run's seeds" "$TCBENCH" inspect run nearest 0 --seed 7 --out bad --quiet
+expect_fail "seed 7 is not one of nearest's seeds in this run" "$TCBENCH" inspect run nearest 0 --seed 7 --out bad --quiet
 expect_fail "no sequence 'synth/nope' (the run's: synth/quadruped_walk)" "$TCBENCH" inspect run nearest 0 --sequence synth/nope --out bad --quiet
 expect_fail "PAIR: expected a pair index or 'worst'" "$TCBENCH" inspect run nearest first --out bad
 expect_fail "is not a run directory" "$TCBENCH" inspect nowhere nearest 0 --out bad --quiet

@@ -47,7 +47,8 @@ static void test_full_config(void **state)
         "     \"sequences\": [{\"name\": \"cat_walk\", \"role\": \"train\"},\n"
         "                     {\"name\": \"horse\", \"role\": \"test\"}]}],\n"
         "  \"methods\": [{\"name\": \"oracle\"},\n"
-        "              {\"name\": \"near2\", \"method\": \"nearest\", \"params\": {\"k\": 2}}] }";
+        "              {\"name\": \"near2\", \"method\": \"nearest\", \"params\": {\"k\": 2},\n"
+        "               \"seeds\": [5]}] }";
     tcb_config c;
     tcb_error err = {0};
     assert_int_equal(tcb_config_parse(text, "full.json", &c, &err), TCB_OK);
@@ -90,6 +91,12 @@ static void test_full_config(void **state)
     assert_string_equal(c.methods[1].label, "near2");
     assert_string_equal(c.methods[1].method, "nearest");
     assert_string_equal(c.methods[1].params_json, "{\"k\":2}");
+    /* A method without its own seeds runs the config's. */
+    assert_int_equal(c.methods[0].n_seeds, 2);
+    assert_int_equal(c.methods[0].seeds[0], 3);
+    assert_int_equal(c.methods[0].seeds[1], 1);
+    assert_int_equal(c.methods[1].n_seeds, 1);
+    assert_int_equal(c.methods[1].seeds[0], 5);
     tcb_config_free(&c);
 }
 
@@ -127,8 +134,9 @@ static void test_normalized_json(void **state)
     (void)state;
     tcb_config c, again;
     tcb_error err = {0};
-    const char *text = config_text(
-        "\"seeds\": [4]", NULL, "{\"name\": \"n\", \"method\": \"nearest\", \"params\": {\"x\": [1, 2]}}");
+    const char *text = config_text("\"seeds\": [4]", NULL,
+                                   "{\"name\": \"n\", \"method\": \"nearest\", \"params\": {\"x\": [1, 2]}}, "
+                                   "{\"name\": \"o\", \"method\": \"oracle\", \"seeds\": [2, 4]}");
     assert_int_equal(tcb_config_parse(text, "t.json", &c, &err), TCB_OK);
     assert_non_null(strstr(c.json_text, "\"pairs\":\t500"));
     assert_non_null(strstr(c.json_text, "\"cache_dir\":\t\".tcbench-cache\""));
@@ -137,6 +145,12 @@ static void test_normalized_json(void **state)
     assert_int_equal(tcb_config_parse(c.json_text, "normalized", &again, &err), TCB_OK);
     assert_string_equal(again.json_text, c.json_text);
     assert_string_equal(again.methods[0].params_json, "{\"x\":[1,2]}");
+    /* Only a method's own seeds are spelled out. */
+    assert_int_equal(again.methods[0].n_seeds, 1);
+    assert_int_equal(again.methods[1].n_seeds, 2);
+    assert_int_equal(again.methods[1].seeds[1], 4);
+    const char *n = strstr(c.json_text, "\"name\":\t\"n\""), *o = strstr(n, "\"name\":\t\"o\"");
+    assert_true(strstr(n, "\"seeds\"") > o);
     tcb_config_free(&again);
     tcb_config_free(&c);
 }
@@ -182,6 +196,11 @@ static const bad_case bad_cases[] = {
     {NULL, SYNTH("\"frames\": true, ", SEQ("quadruped_walk", "test")), NULL,
      "t.json: datasets[0].frames: expected an integer, got a boolean"},
     {NULL, NULL, "{\"name\": \"n\", \"params\": [1]}", "t.json: methods[0].params: expected an object"},
+    {NULL, NULL, "{\"name\": \"n\", \"seeds\": 1}", "t.json: methods[0].seeds: expected an array"},
+    {NULL, NULL, "{\"name\": \"n\", \"seeds\": []}", "t.json: methods[0].seeds: must list at least one seed"},
+    {NULL, NULL, "{\"name\": \"n\", \"seeds\": [0, 0.5]}",
+     "t.json: methods[0].seeds[1]: expected a non-negative integer"},
+    {NULL, NULL, "{\"name\": \"n\", \"seeds\": [2, 2]}", "t.json: methods[0].seeds[1]: duplicate seed 2"},
     {NULL, NULL, "{\"name\": 3}", "t.json: methods[0].name: expected a string, got a number"},
     {NULL, "3", NULL, "t.json: datasets[0]: expected an object, got a number"},
     /* unknown keys at every level */

@@ -53,7 +53,9 @@ static void test_grid_and_resume(void **state)
     char dir[512], path[1024];
     tu_make_tmpdir(dir, sizeof dir);
     tcb_config c;
-    parse_config(dir, "{\"name\": \"oracle\"}, {\"name\": \"nearest\"}", "", &c);
+    /* nearest runs its own seeds instead of the config's 0 and 1. */
+    parse_config(dir, "{\"name\": \"oracle\"}, {\"name\": \"nearest\", \"seeds\": [1, 5]}", "",
+                 &c);
     progress_log log = {0};
     tcb_run_opts opts = {.reporter = {on_progress, NULL, &log}};
     tcb_run_stats st;
@@ -65,10 +67,12 @@ static void test_grid_and_resume(void **state)
     assert_int_equal(st.cells_skipped, 0);
     assert_int_equal(st.cells_failed, 0);
     assert_int_equal(log.finished_cells, 4);
-    assert_string_equal(log.last_label, "synth/quadruped_walk/nearest/seed 1");
+    assert_string_equal(log.last_label, "synth/quadruped_walk/nearest/seed 5");
     snprintf(path, sizeof path, "%s/run/cells/synth/quadruped_walk/oracle/seed_1.json", dir);
     assert_true(tcb_is_file(path));
-    snprintf(path, sizeof path, "%s/run/work/synth/quadruped_walk/nearest/seed_0", dir);
+    snprintf(path, sizeof path, "%s/run/cells/synth/quadruped_walk/nearest/seed_0.json", dir);
+    assert_false(tcb_is_file(path));
+    snprintf(path, sizeof path, "%s/run/work/synth/quadruped_walk/nearest/seed_5", dir);
     assert_true(tcb_is_dir(path));
 
     /* config.json is the normalized config. */
