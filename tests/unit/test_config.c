@@ -6,6 +6,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -286,6 +287,31 @@ static void test_missing_lists_and_name(void **state)
     }
 }
 
+/* Every config shipped in configs/ parses: a typo there would otherwise
+ * surface only when somebody runs that (possibly hours-long) config. */
+static void test_shipped_configs_parse(void **state)
+{
+    (void)state;
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s/configs", TCB_SOURCE_DIR);
+    DIR *d = opendir(dir);
+    assert_non_null(d);
+    int n = 0;
+    for (struct dirent *e; (e = readdir(d));) {
+        size_t len = strlen(e->d_name);
+        if (len < 6 || strcmp(e->d_name + len - 5, ".json")) continue;
+        char path[8192];
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        tcb_config c;
+        tcb_error err = {0};
+        if (tcb_config_load(path, &c, &err)) fail_msg("%s", err.msg);
+        tcb_config_free(&c);
+        n++;
+    }
+    closedir(d);
+    assert_true(n >= 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -295,6 +321,7 @@ int main(void)
         cmocka_unit_test(test_load_file),
         cmocka_unit_test(test_bad_configs),
         cmocka_unit_test(test_missing_lists_and_name),
+        cmocka_unit_test(test_shipped_configs_parse),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
