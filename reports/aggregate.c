@@ -51,6 +51,33 @@ static int build_gaps(const tcb_cell_result *cells, int n, tcb_rpt_row *r, tcb_e
     return TCB_OK;
 }
 
+static void set_seed_stat(tcb_rpt_seed *s, int m, const tcb_stat *st)
+{
+    s->has[m] = st->n > 0;
+    s->mean[m] = st->mean * tcb_rpt_metrics[m].scale;
+}
+
+/* Each cell of the row on its own, failed ones included (as their status). */
+static int build_seeds(const tcb_cell_result *cells, int n, tcb_rpt_row *r, tcb_error *err)
+{
+    r->by_seed = calloc((size_t)n, sizeof *r->by_seed);
+    if (!r->by_seed) return tcb_fail(err, TCB_ERR_NOMEM, "report: out of memory");
+    r->n_by_seed = n;
+    for (int k = 0; k < n; k++) {
+        const tcb_cell_result *c = &cells[k];
+        tcb_rpt_seed *s = &r->by_seed[k];
+        s->seed = c->seed;
+        s->status = tcb_cell_status_name(c->status);
+        s->n_pairs = c->n_pairs;
+        if (c->status != TCB_CELL_OK) continue;
+        set_seed_stat(s, TCB_M_SL2, &c->summary.sl2);
+        set_seed_stat(s, TCB_M_RANK, &c->summary.rank);
+        set_seed_stat(s, TCB_M_AUC, &c->summary.auc);
+        set_seed_stat(s, TCB_M_CD, &c->summary.cd);
+    }
+    return TCB_OK;
+}
+
 /* cells[0 .. n): one method of one block, ascending seeds. */
 static int build_row(const tcb_cell_result *cells, int n, tcb_rpt_row *r, tcb_error *err)
 {
@@ -58,6 +85,8 @@ static int build_row(const tcb_cell_result *cells, int n, tcb_rpt_row *r, tcb_er
     snprintf(r->method, sizeof r->method, "%s", cells[0].method);
     r->n_seeds = n;
     r->status = "ok";
+    int rc = build_seeds(cells, n, r, err);
+    if (rc) return rc;
     int n_bad = 0;
     tcb_summary pooled;
     tcb_summary_init(&pooled);
@@ -103,25 +132,54 @@ static double displayed(double x, int decimals)
     return strtod(buf, NULL);
 }
 
-static void mark_best(tcb_rpt_block *b)
+/* Where a metric's values and best marks live: a row or one of its seeds. */
+typedef struct candidate {
+    const int *has;
+    const double *mean;
+    int *best;
+} candidate;
+
+/* Marks, per metric, every candidate whose displayed value is the best. */
+static void mark_best(const candidate *c, int n)
 {
     for (int m = 0; m < TCB_N_METRICS; m++) {
         const tcb_rpt_metric_def *d = &tcb_rpt_metrics[m];
         double best = d->lower_is_better ? INFINITY : -INFINITY;
-        for (int k = 0; k < b->n_rows; k++) {
-            if (!b->rows[k].has[m]) continue;
-            double v = displayed(b->rows[k].mean[m], d->decimals);
+        for (int k = 0; k < n; k++) {
+            if (!c[k].has[m]) continue;
+            double v = displayed(c[k].mean[m], d->decimals);
             if (d->lower_is_better ? v < best : v > best) best = v;
         }
-        for (int k = 0; k < b->n_rows; k++)
-            b->rows[k].best[m] =
-                b->rows[k].has[m] && displayed(b->rows[k].mean[m], d->decimals) == best;
+        for (int k = 0; k < n; k++)
+            c[k].best[m] = c[k].has[m] && displayed(c[k].mean[m], d->decimals) == best;
     }
+}
+
+/* The block's rows compared, then for each seed the rows' cells of it
+ * (b->seed_list must be in place). */
+static int mark_block_best(tcb_rpt_block *b, tcb_error *err)
+{
+    candidate *c = malloc(((size_t)b->n_rows + 1) * sizeof *c);
+    if (!c) return tcb_fail(err, TCB_ERR_NOMEM, "report: out of memory");
+    for (int k = 0; k < b->n_rows; k++)
+        c[k] = (candidate){b->rows[k].has, b->rows[k].mean, b->rows[k].best};
+    mark_best(c, b->n_rows);
+    for (int d = 0; d < b->n_seed_list; d++) {
+        int n = 0;
+        for (int k = 0; k < b->n_rows; k++)
+            for (int i = 0; i < b->rows[k].n_by_seed; i++) {
+                tcb_rpt_seed *s = &b->rows[k].by_seed[i];
+                if (s->seed == b->seed_list[d]) c[n++] = (candidate){s->has, s->mean, s->best};
+            }
+        mark_best(c, n);
+    }
+    free(c);
+    return TCB_OK;
 }
 
 /* Pair-count range over the rows that scored pairs (a failed cell may have
  * none), and the best marks, once the rows are in place. */
-static void finish_block(tcb_rpt_block *b)
+static int finish_block(tcb_rpt_block *b, tcb_error *err)
 {
     int any_ok = 0;
     for (int k = 0; k < b->n_rows; k++) any_ok |= !strcmp(b->rows[k].status, "ok");
@@ -133,7 +191,7 @@ static void finish_block(tcb_rpt_block *b)
         if (r->n_pairs < b->n_pairs_min) b->n_pairs_min = r->n_pairs;
         if (r->n_pairs > b->n_pairs_max) b->n_pairs_max = r->n_pairs;
     }
-    mark_best(b);
+    return mark_block_best(b, err);
 }
 
 /* ----------------------------------------------------------- one block */
@@ -144,24 +202,26 @@ static int cmp_int(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* The block's distinct seeds, as a list and as the "0, 1" of its heading. */
 static int block_seeds(const tcb_cell_result *cells, int n, tcb_rpt_block *b, tcb_error *err)
 {
-    int *seeds = malloc((size_t)n * sizeof *seeds);
-    if (!seeds) return tcb_fail(err, TCB_ERR_NOMEM, "report: out of memory");
-    for (int k = 0; k < n; k++) seeds[k] = cells[k].seed;
-    qsort(seeds, (size_t)n, sizeof *seeds, cmp_int);
+    b->seed_list = malloc((size_t)n * sizeof *b->seed_list);
+    if (!b->seed_list) return tcb_fail(err, TCB_ERR_NOMEM, "report: out of memory");
+    for (int k = 0; k < n; k++) b->seed_list[k] = cells[k].seed;
+    qsort(b->seed_list, (size_t)n, sizeof *b->seed_list, cmp_int);
+    for (int k = 0; k < n; k++)
+        if (!b->n_seed_list || b->seed_list[k] != b->seed_list[b->n_seed_list - 1])
+            b->seed_list[b->n_seed_list++] = b->seed_list[k];
     size_t used = 0;
-    for (int k = 0; k < n; k++) {
-        if (k > 0 && seeds[k] == seeds[k - 1]) continue;
+    for (int k = 0; k < b->n_seed_list; k++) {
         int w = snprintf(b->seeds + used, sizeof b->seeds - used, "%s%d", used ? ", " : "",
-                         seeds[k]);
+                         b->seed_list[k]);
         if (w < 0 || (size_t)w >= sizeof b->seeds - used) {
             memcpy(b->seeds + sizeof b->seeds - sizeof ", …", ", …", sizeof ", …");
             break;
         }
         used += (size_t)w;
     }
-    free(seeds);
     return TCB_OK;
 }
 
@@ -187,8 +247,8 @@ static int build_block(const tcb_cell_result *cells, int n, tcb_rpt_block *b, tc
         if (rc) return rc;
         k = e;
     }
-    finish_block(b);
-    return block_seeds(cells, n, b, err);
+    int rc = block_seeds(cells, n, b, err);
+    return rc ? rc : finish_block(b, err);
 }
 
 /* ------------------------------------------------------ MEAN of a dataset */
@@ -283,9 +343,8 @@ static int build_mean(tcb_rpt *r, tcb_rpt_dataset *d, tcb_error *err)
         }
     qsort(m->rows, (size_t)m->n_rows, sizeof *m->rows, cmp_row);
     snprintf(m->seeds, sizeof m->seeds, "%s", tests[0]->seeds);
-    finish_block(m);
     free(tests);
-    return TCB_OK;
+    return finish_block(m, err);
 }
 
 /* --------------------------------------------------------------- the run */
@@ -343,8 +402,12 @@ int tcb_rpt_load(const char *run_dir, tcb_rpt *out, tcb_error *err)
 void tcb_rpt_free(tcb_rpt *r)
 {
     for (int k = 0; k < r->n_blocks; k++) {
-        for (int i = 0; i < r->blocks[k].n_rows; i++) free(r->blocks[k].rows[i].by_gap);
+        for (int i = 0; i < r->blocks[k].n_rows; i++) {
+            free(r->blocks[k].rows[i].by_gap);
+            free(r->blocks[k].rows[i].by_seed);
+        }
         free(r->blocks[k].rows);
+        free(r->blocks[k].seed_list);
     }
     for (int k = 0; k < r->n_datasets; k++) free(r->datasets[k].mean.rows);
     free(r->blocks);

@@ -40,6 +40,17 @@ typedef struct tcb_rpt_gap {
     tcb_stat sl2;                     /* per-vertex Euclidean error, raw units */
 } tcb_rpt_gap;
 
+/* One cell of a row, unpooled: how much the method's numbers move with the
+ * seed, which the pooled mean ± std (over vertices and pairs) cannot show. */
+typedef struct tcb_rpt_seed {
+    int seed;
+    const char *status;               /* the cell's status name */
+    int n_pairs;
+    int has[TCB_N_METRICS];           /* 0 → "-" (no reconstruction, or not ok) */
+    int best[TCB_N_METRICS];          /* best among the block's cells of this seed */
+    double mean[TCB_N_METRICS];       /* table units */
+} tcb_rpt_seed;
+
 typedef struct tcb_rpt_row {
     char method[64];
     const char *status;               /* "ok", "failed", "diverged" or "missing" */
@@ -55,6 +66,8 @@ typedef struct tcb_rpt_row {
     double pck[TCB_PCK_STEPS];        /* percent; valid when status is "ok" */
     int n_gaps;                       /* largest |i − j| + 1; 0 unless ok, and in MEAN rows */
     tcb_rpt_gap *by_gap;              /* malloc'ed [n_gaps], indexed by |i − j| */
+    int n_by_seed;                    /* = n_seeds; 0 in MEAN rows */
+    tcb_rpt_seed *by_seed;            /* malloc'ed [n_by_seed], ascending seed */
 } tcb_rpt_row;
 
 typedef struct tcb_rpt_block {
@@ -62,6 +75,8 @@ typedef struct tcb_rpt_block {
     char sequence[128];               /* "MEAN" for a dataset mean block */
     char role[16];                    /* "train" | "validation" | "test" | "mean" */
     char seeds[128];                  /* distinct seeds, "0, 1" */
+    int n_seed_list;                  /* the same as numbers; 0 in MEAN blocks */
+    int *seed_list;                   /* malloc'ed [n_seed_list], ascending */
     int n_pairs_min, n_pairs_max;     /* over the block's rows */
     int n_rows;
     tcb_rpt_row *rows;                /* [n_rows], sorted by method */

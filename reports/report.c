@@ -1,4 +1,4 @@
-/* `tcbench report`: tables.md, tables.tex, results.csv, by_gap.csv and two
+/* `tcbench report`: tables.md, tables.tex, results.csv, by_gap.csv, seeds.csv and two
  * plots per sequence (PCK, m_sL2 by frame distance), each published
  * atomically. */
 #include "tcb/report.h"
@@ -37,7 +37,8 @@ static int write_all(const tcb_rpt *r, const char *dir, tcb_error *err)
     if (rc || (rc = write_text(dir, "tables.md", tcb_rpt_write_md, r, err)) ||
         (rc = write_text(dir, "tables.tex", tcb_rpt_write_tex, r, err)) ||
         (rc = write_text(dir, "results.csv", tcb_rpt_write_csv, r, err)) ||
-        (rc = write_text(dir, "by_gap.csv", tcb_rpt_write_gap_csv, r, err)))
+        (rc = write_text(dir, "by_gap.csv", tcb_rpt_write_gap_csv, r, err)) ||
+        (rc = write_text(dir, "seeds.csv", tcb_rpt_write_seed_csv, r, err)))
         return rc;
     for (int k = 0; k < r->n_blocks && !rc; k++)
         if (!(rc = write_plot(dir, "pck", tcb_rpt_plot_pck, &r->blocks[k], err)))

@@ -3,7 +3,10 @@
  * precision; empty fields where the tables show "-" or a status.
  *
  * by_gap.csv: one row per (dataset, sequence, method, frame distance) that
- * has pairs, for the methods whose cells are all ok. */
+ * has pairs, for the methods whose cells are all ok.
+ *
+ * seeds.csv: one row per cell (dataset, sequence, method, seed), its own
+ * means unpooled; empty fields where the cell has no value. */
 #include <string.h>
 
 #include "reports/writers.h"
@@ -80,6 +83,25 @@ void tcb_rpt_write_gap_csv(FILE *f, const tcb_rpt *r)
                 put_block(f, &r->blocks[k], row);
                 fprintf(f, ",%d,%d,%.0f,%.*f,%.*f\n", g, gap->n_pairs, gap->sl2.n, d->decimals,
                         gap->sl2.mean * d->scale, d->decimals, tcb_stat_std(&gap->sl2) * d->scale);
+            }
+        }
+}
+
+void tcb_rpt_write_seed_csv(FILE *f, const tcb_rpt *r)
+{
+    fputs("dataset,sequence,role,method,seed,status,n_pairs,sl2_x1e3_mean,rank_pct_mean,"
+          "auc_pct_mean,cd_x1e3_mean\n",
+          f);
+    for (int k = 0; k < r->n_blocks; k++)
+        for (int i = 0; i < r->blocks[k].n_rows; i++) {
+            const tcb_rpt_row *row = &r->blocks[k].rows[i];
+            for (int j = 0; j < row->n_by_seed; j++) {
+                const tcb_rpt_seed *s = &row->by_seed[j];
+                put_block(f, &r->blocks[k], row);
+                fprintf(f, ",%d,%s,%d", s->seed, s->status, s->n_pairs);
+                for (int m = 0; m < TCB_N_METRICS; m++)
+                    put_num(f, s->has[m], s->mean[m], tcb_rpt_metrics[m].decimals);
+                fputc('\n', f);
             }
         }
 }

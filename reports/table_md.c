@@ -1,5 +1,6 @@
-/* Markdown tables shaped like the paper's: a block per sequence, a MEAN
- * block per dataset over its test sequences. */
+/* Markdown tables shaped like the paper's: a block per sequence (with its
+ * cells seed by seed when a method ran several), a MEAN block per dataset
+ * over its test sequences. */
 #include <string.h>
 
 #include "reports/chart.h"
@@ -41,6 +42,48 @@ static void write_table(FILE *f, const tcb_rpt_block *b)
     fprintf(f, "\n");
 }
 
+/* A seed's value: "12.34", bold when best among the block's cells of that
+ * seed, "-" or the cell's status like the pooled table. */
+static void seed_cell(const tcb_rpt_seed *s, int m, char *out, size_t size)
+{
+    const tcb_rpt_metric_def *d = &tcb_rpt_metrics[m];
+    if (strcmp(s->status, "ok"))
+        snprintf(out, size, "*%s*", s->status);
+    else if (!s->has[m])
+        snprintf(out, size, "-");
+    else
+        snprintf(out, size, "%s%.*f%s", s->best[m] ? "**" : "", d->decimals, s->mean[m],
+                 s->best[m] ? "**" : "");
+}
+
+/* Each cell's means, grouped by seed, best per seed in bold: whether the
+ * ranking of the pooled table holds seed by seed. */
+static void write_seed_table(FILE *f, const tcb_rpt_block *b)
+{
+    int several = 0;
+    for (int k = 0; k < b->n_rows; k++) several |= b->rows[k].n_by_seed > 1;
+    if (!several) return;
+    fprintf(f, "Per seed (each cell's means; best per seed in **bold**):\n\n| seed | method |");
+    for (int m = 0; m < TCB_N_METRICS; m++) fprintf(f, " %s |", tcb_rpt_metrics[m].label);
+    fprintf(f, "\n|---:|:---|");
+    for (int m = 0; m < TCB_N_METRICS; m++) fprintf(f, "---:|");
+    fprintf(f, "\n");
+    for (int d = 0; d < b->n_seed_list; d++)
+        for (int k = 0; k < b->n_rows; k++)
+            for (int i = 0; i < b->rows[k].n_by_seed; i++) {
+                const tcb_rpt_seed *s = &b->rows[k].by_seed[i];
+                if (s->seed != b->seed_list[d]) continue;
+                fprintf(f, "| %d | %s |", s->seed, b->rows[k].method);
+                for (int m = 0; m < TCB_N_METRICS; m++) {
+                    char cell[64];
+                    seed_cell(s, m, cell, sizeof cell);
+                    fprintf(f, " %s |", cell);
+                }
+                fprintf(f, "\n");
+            }
+    fprintf(f, "\n");
+}
+
 /* The block's plots, written beside tables.md by the report. */
 static void write_plot_links(FILE *f, const tcb_rpt_block *b)
 {
@@ -62,6 +105,7 @@ static void write_dataset(FILE *f, const tcb_rpt *r, const tcb_rpt_dataset *d)
         fprintf(f, "### %s / %s\n\nrole: %s · pairs: %s · seeds: %s\n\n", d->name, b->sequence,
                 b->role, pairs, b->seeds);
         write_table(f, b);
+        write_seed_table(f, b);
         write_plot_links(f, b);
     }
     if (!d->n_test) {

@@ -14,6 +14,8 @@ void tcb_rpt_write_tex(FILE *f, const tcb_rpt *r);  /* reports/table_tex.c */
 void tcb_rpt_write_csv(FILE *f, const tcb_rpt *r);  /* reports/table_csv.c */
 /* by_gap.csv: each sequence row's m_sL2 per frame distance. (reports/table_csv.c) */
 void tcb_rpt_write_gap_csv(FILE *f, const tcb_rpt *r);
+/* seeds.csv: each cell's own means. (reports/table_csv.c) */
+void tcb_rpt_write_seed_csv(FILE *f, const tcb_rpt *r);
 
 /* One PNG per block, published atomically at `path`: the PCK curves
  * (reports/plot_pck.c) and m_sL2 by frame distance (reports/plot_gap.c). */

@@ -57,12 +57,12 @@ typedef struct expect {
     double mean[4], std[4];
 } expect;
 
-static expect expected(int s, int m)
+static expect expected_seeds(int s, int m, int first_seed, int n_seeds)
 {
     double sl2[8 * FAKE_PAIRS * FAKE_NV], rank[8 * FAKE_PAIRS * FAKE_NV];
     double auc[8 * FAKE_PAIRS], cd[8 * FAKE_PAIRS];
     int nv = 0, np = 0;
-    for (int seed = 0; seed < METHODS[m].n_seeds; seed++) {
+    for (int seed = first_seed; seed < first_seed + n_seeds; seed++) {
         fake_cell c = cell_of(s, m, seed);
         for (int p = 0; p < FAKE_PAIRS; p++, np++) {
             tcb_pair_metrics pm;
@@ -84,6 +84,8 @@ static expect expected(int s, int m)
     for (int k = 0; k < 4; k++) e.mean[k] *= scale[k], e.std[k] *= scale[k];
     return e;
 }
+
+static expect expected(int s, int m) { return expected_seeds(s, m, 0, METHODS[m].n_seeds); }
 
 /* The dataset MEAN over the given sequences (§5.6: means and stds averaged
  * separately). */
@@ -241,6 +243,49 @@ static void test_md_mean_over_test_sequences_only(void **state)
     free(ama);
 }
 
+/* "| 1 | AN | **1.23** | … |": one cell's means, `bold` a 4-bit mask. */
+static void md_seed_row(int seed, const char *method, const expect *e, int bold, int no_cd,
+                        char *out, size_t size)
+{
+    size_t used = (size_t)snprintf(out, size, "| %d | %s |", seed, method);
+    for (int j = 0; j < 4; j++) {
+        const char *b = bold >> j & 1 ? "**" : "";
+        if (j == 3 && no_cd)
+            used += (size_t)snprintf(out + used, size - used, " - |");
+        else
+            used += (size_t)snprintf(out + used, size - used, " %s%.*f%s |", b, DECIMALS[j],
+                                     e->mean[j], b);
+    }
+}
+
+static void test_md_per_seed_table(void **state)
+{
+    fixture *f = *state;
+    char *horse = section(f->md, "### anim / horse");
+    char row[512];
+    assert_contains(horse, "Per seed (each cell's means; best per seed in **bold**):");
+    /* Seed 0: every method, DSR best, rank tied; seed 1: AN alone, so best. */
+    expect an0 = expected_seeds(1, 0, 0, 1), an1 = expected_seeds(1, 0, 1, 1);
+    expect nn0 = expected_seeds(1, 1, 0, 1), dsr0 = expected_seeds(1, 2, 0, 1);
+    md_seed_row(0, "AN", &an0, 0x2, 0, row, sizeof row);
+    assert_contains(horse, row);
+    md_seed_row(0, "NN", &nn0, 0x2, 1, row, sizeof row);
+    assert_contains(horse, row);
+    md_seed_row(0, "DSR", &dsr0, 0xF, 0, row, sizeof row);
+    assert_contains(horse, row);
+    md_seed_row(1, "AN", &an1, 0xF, 0, row, sizeof row);
+    assert_contains(horse, row);
+    /* Seed order: all of seed 0 before seed 1. */
+    assert_true(strstr(horse, "| 0 | NN |") < strstr(horse, "| 1 | AN |"));
+    free(horse);
+    char *camel = section(f->md, "### anim / camel");
+    assert_contains(camel, "| 0 | DSR | *failed* | *failed* | *failed* | *failed* |");
+    free(camel);
+    char *mean = section(f->md, "### anim / MEAN");
+    assert_null(strstr(mean, "Per seed"));
+    free(mean);
+}
+
 /* ------------------------------------------------------------------ CSV */
 
 typedef struct csv_row {
@@ -266,6 +311,19 @@ static int parse_csv(const char *text, int n_fields, csv_row *rows, int max)
         line = end + 1;
     }
     return n;
+}
+
+/* report/<name> parsed, `n_fields` per line; *n gets the line count
+ * (header included). The caller frees the rows. */
+static csv_row *read_csv(const fixture *f, const char *name, int n_fields, int *n)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s", f->report, name);
+    char *text = read_all(path);
+    csv_row *rows = calloc(64, sizeof *rows);
+    *n = parse_csv(text, n_fields, rows, 64);
+    free(text);
+    return rows;
 }
 
 static const csv_row *find_csv(const csv_row *rows, int n, const char *seq, const char *method)
@@ -294,11 +352,8 @@ static void assert_csv_values(const csv_row *r, const expect *e, int has_cd)
 static void test_csv_parses_back(void **state)
 {
     fixture *f = *state;
-    char path[4096];
-    snprintf(path, sizeof path, "%s/results.csv", f->report);
-    char *text = read_all(path);
-    csv_row *rows = calloc(64, sizeof *rows);
-    int n = parse_csv(text, 17, rows, 64);
+    int n;
+    csv_row *rows = read_csv(f, "results.csv", 17, &n);
     /* header + 4 sequences × 3 methods + anim's 3 MEAN rows */
     assert_int_equal(n, 1 + 12 + 3);
     assert_string_equal(rows[0].field[7], "sl2_x1e3_mean");
@@ -319,7 +374,6 @@ static void test_csv_parses_back(void **state)
     assert_string_equal(r->field[4], "failed");
     assert_string_equal(r->field[7], "");
     free(rows);
-    free(text);
 }
 
 /* m_sL2 of (sequence, method) over the pairs at frame distance `gap`,
@@ -354,11 +408,8 @@ static const csv_row *find_gap(const csv_row *rows, int n, const char *seq, cons
 static void test_gap_csv_by_frame_distance(void **state)
 {
     fixture *f = *state;
-    char path[4096];
-    snprintf(path, sizeof path, "%s/by_gap.csv", f->report);
-    char *text = read_all(path);
-    csv_row *rows = calloc(64, sizeof *rows);
-    int n = parse_csv(text, 9, rows, 64);
+    int n;
+    csv_row *rows = read_csv(f, "by_gap.csv", 9, &n);
     assert_string_equal(rows[0].field[4], "gap");
     /* 2 distances × (4 sequences × 3 methods − DSR failed on camel); no MEAN rows. */
     assert_int_equal(n, 1 + 2 * (N_SEQS * N_METHODS - 1));
@@ -381,7 +432,47 @@ static void test_gap_csv_by_frame_distance(void **state)
     /* Two seeds of AN pooled: both pairs at distance 2. */
     assert_string_equal(find_gap(rows, n, "horse", "AN", 2)->field[5], "2");
     free(rows);
-    free(text);
+}
+
+static void test_seed_csv_one_row_per_cell(void **state)
+{
+    fixture *f = *state;
+    int n;
+    csv_row *rows = read_csv(f, "seeds.csv", 11, &n);
+    assert_string_equal(rows[0].field[4], "seed");
+    int n_cells = 0;
+    for (int m = 0; m < N_METHODS; m++) n_cells += N_SEQS * METHODS[m].n_seeds;
+    assert_int_equal(n, 1 + n_cells);
+    for (int s = 0; s < N_SEQS; s++)
+        for (int m = 0; m < N_METHODS; m++)
+            for (int seed = 0; seed < METHODS[m].n_seeds; seed++) {
+                const csv_row *r = NULL;
+                for (int k = 1; k < n && !r; k++)
+                    if (!strcmp(rows[k].field[1], SEQS[s].name) &&
+                        !strcmp(rows[k].field[3], METHODS[m].name) && atoi(rows[k].field[4]) == seed)
+                        r = &rows[k];
+                assert_non_null(r);
+                assert_string_equal(r->field[2], SEQS[s].role);
+                fake_cell c = cell_of(s, m, seed);
+                /* A failed cell scored no pairs. */
+                assert_int_equal(atoi(r->field[6]), c.status == TCB_CELL_OK ? FAKE_PAIRS : 0);
+                if (c.status != TCB_CELL_OK) {
+                    assert_string_equal(r->field[5], "failed");
+                    for (int j = 0; j < 4; j++) assert_string_equal(r->field[7 + j], "");
+                    continue;
+                }
+                assert_string_equal(r->field[5], "ok");
+                expect e = expected_seeds(s, m, seed, 1);
+                for (int j = 0; j < 4; j++) {
+                    if (j == 3 && !METHODS[m].has_cd) {
+                        assert_string_equal(r->field[7 + j], "");
+                        continue;
+                    }
+                    double half_ulp = 0.5 * pow(10, -DECIMALS[j]) + 1e-12;
+                    assert_true(fabs(strtod(r->field[7 + j], NULL) - e.mean[j]) <= half_ulp);
+                }
+            }
+    free(rows);
 }
 
 /* ----------------------------------------------------------- TeX, PNG */
@@ -436,7 +527,7 @@ static void test_pngs_are_valid(void **state)
         n++;
     }
     closedir(d);
-    assert_int_equal(n, 4 + 2 * N_SEQS);
+    assert_int_equal(n, 5 + 2 * N_SEQS);
 }
 
 static void test_empty_run_is_an_error(void **state)
@@ -464,8 +555,10 @@ int main(void)
         cmocka_unit_test(test_md_sequence_block_bold_and_dash),
         cmocka_unit_test(test_md_failed_method_shows_status),
         cmocka_unit_test(test_md_mean_over_test_sequences_only),
+        cmocka_unit_test(test_md_per_seed_table),
         cmocka_unit_test(test_csv_parses_back),
         cmocka_unit_test(test_gap_csv_by_frame_distance),
+        cmocka_unit_test(test_seed_csv_one_row_per_cell),
         cmocka_unit_test(test_tex_uses_booktabs),
         cmocka_unit_test(test_pngs_are_valid),
     };
