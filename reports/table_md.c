@@ -14,6 +14,19 @@ static void pairs_text(const tcb_rpt_block *b, char *out, size_t size)
         snprintf(out, size, "%d–%d", b->n_pairs_min, b->n_pairs_max);
 }
 
+/* " (seeds 0, 2)" after a method that ran on fewer of the block's seeds than
+ * the others: its pooled numbers then rest on fewer seeds than the heading
+ * says. Empty otherwise. */
+static void fewer_seeds_note(const tcb_rpt_block *b, const tcb_rpt_row *r, char *out, size_t size)
+{
+    out[0] = '\0';
+    if (r->n_by_seed == 0 || r->n_by_seed >= b->n_seed_list) return;
+    size_t used = (size_t)snprintf(out, size, " (seed%s", r->n_by_seed > 1 ? "s" : "");
+    for (int i = 0; i < r->n_by_seed && used < size; i++)
+        used += (size_t)snprintf(out + used, size - used, "%s %d", i ? "," : "", r->by_seed[i].seed);
+    if (used < size) snprintf(out + used, size - used, ")");
+}
+
 static void write_table(FILE *f, const tcb_rpt_block *b)
 {
     fprintf(f, "| method |");
@@ -23,7 +36,9 @@ static void write_table(FILE *f, const tcb_rpt_block *b)
     fprintf(f, "\n");
     for (int k = 0; k < b->n_rows; k++) {
         const tcb_rpt_row *r = &b->rows[k];
-        fprintf(f, "| %s |", r->method);
+        char note[128];
+        fewer_seeds_note(b, r, note, sizeof note);
+        fprintf(f, "| %s%s |", r->method, note);
         for (int m = 0; m < TCB_N_METRICS; m++) {
             char cell[128];
             tcb_rpt_cell_text(r, m, " ± ", cell, sizeof cell);

@@ -194,13 +194,15 @@ static void test_md_sequence_block_bold_and_dash(void **state)
     char *horse = section(f->md, "### anim / horse");
     char row[512];
     expect an = expected(1, 0), nn = expected(1, 1), dsr = expected(1, 2);
-    /* DSR is best everywhere; rank ties across methods, so all bold. */
+    /* DSR is best everywhere; rank ties across methods, so all bold. NN and
+     * DSR ran one of the heading's two seeds, which their rows say. */
     md_row("AN", &an, 0x2, 0, row, sizeof row);
     assert_contains(horse, row);
-    md_row("NN", &nn, 0x2, 1, row, sizeof row);
+    md_row("NN (seed 0)", &nn, 0x2, 1, row, sizeof row);
     assert_contains(horse, row);
-    md_row("DSR", &dsr, 0xF, 0, row, sizeof row);
+    md_row("DSR (seed 0)", &dsr, 0xF, 0, row, sizeof row);
     assert_contains(horse, row);
+    assert_null(strstr(horse, "| AN ("));
     assert_contains(horse, "role: test · pairs: 2 · seeds: 0, 1");
     /* Links to the block's plots, which test_pngs_are_valid finds on disk. */
     assert_contains(horse, "![PCK curves](pck_anim_horse.png) "
@@ -212,7 +214,7 @@ static void test_md_failed_method_shows_status(void **state)
 {
     fixture *f = *state;
     char *camel = section(f->md, "### anim / camel");
-    assert_contains(camel, "| DSR | *failed* | *failed* | *failed* | *failed* |");
+    assert_contains(camel, "| DSR (seed 0) | *failed* | *failed* | *failed* | *failed* |");
     assert_contains(camel, "- DSR: failed — seed 0: loss became NaN at iteration 7");
     free(camel);
 }
