@@ -53,11 +53,14 @@ static int fill_identity(const tcb_cell_job *job, tcb_cell_result *c, tcb_error 
 /* Saved through a temporary name so a kill mid-save leaves no torn
  * checkpoint for the next run to trust. A failed save costs only a refit
  * on resume, so it is a warning, not a cell failure. */
-static void save_checkpoint(const tcb_cell_job *job, void *self, const char *path)
+static void save_checkpoint(const tcb_cell_job *job, void *self, double fit_s)
 {
+    const char *path = job->checkpoint;
     char tmp[TCB_PATH_MAX];
     tcb_error e = {0};
-    int rc = tcb_temp_path_for(path, tmp, sizeof tmp, &e);
+    /* The record goes first: a published checkpoint always has one. */
+    int rc = tcb_fit_time_save(path, fit_s, &e);
+    if (!rc) rc = tcb_temp_path_for(path, tmp, sizeof tmp, &e);
     if (!rc) {
         rc = job->ops->save(self, tmp, &e);
         if (!rc) rc = tcb_publish(tmp, path, &e);
@@ -87,10 +90,25 @@ static int create_method(const tcb_cell_job *job, void **self, tcb_error *merr)
     return rc;
 }
 
-/* create + (load | fit [+ save]); on failure nothing is left to destroy. */
-static int prepare_method(const tcb_cell_job *job, void **self, tcb_error *merr)
+/* The fit time of a reused checkpoint; without its record (a checkpoint
+ * from before records were kept) only the loading is counted, and said. */
+static double reused_fit_time(const tcb_cell_job *job)
+{
+    double fit_s = 0;
+    tcb_error e = {0};
+    if (tcb_fit_time_load(job->checkpoint, &fit_s, &e) == TCB_OK) return fit_s;
+    tcb_report_log(&job->reporter, TCB_LOG_WARN, "fit time unknown (%s): fit_s counts only loading the model",
+                   e.msg);
+    return 0;
+}
+
+/* create + (load | fit [+ save]); on failure nothing is left to destroy.
+ * *fit_s (fit_s may be NULL) gets the whole fit's seconds: this process's,
+ * plus what a resumed training or a reused checkpoint cost before. */
+static int prepare_method(const tcb_cell_job *job, void **self, double *fit_s, tcb_error *merr)
 {
     const tcb_method_ops *ops = job->ops;
+    double t0 = tcb_now_seconds(), earlier = 0;
     if (job->require_checkpoint && ops->load && !tcb_is_file(job->checkpoint))
         return tcb_fail(merr, TCB_ERR_IO, "%s: no such file: the cell has no fitted model yet",
                         job->checkpoint);
@@ -98,7 +116,10 @@ static int prepare_method(const tcb_cell_job *job, void **self, tcb_error *merr)
     if (rc) return rc;
     if (ops->load && job->reuse_checkpoint && tcb_is_file(job->checkpoint)) {
         tcb_error le = {0};
-        if (ops->load(*self, job->seq, job->checkpoint, &le) == TCB_OK) return TCB_OK;
+        if (ops->load(*self, job->seq, job->checkpoint, &le) == TCB_OK) {
+            if (fit_s) *fit_s = reused_fit_time(job) + tcb_now_seconds() - t0;
+            return TCB_OK;
+        }
         if (job->require_checkpoint) {
             ops->destroy(*self);
             return tcb_fail(merr, le.code ? le.code : TCB_ERR_INPUT, "%s", le.msg);
@@ -110,15 +131,17 @@ static int prepare_method(const tcb_cell_job *job, void **self, tcb_error *merr)
         rc = create_method(job, self, merr);
         if (rc) return rc;
     }
-    tcb_fit_ctx ctx = {(uint64_t)job->seed, job->threads, job->work_dir, job->reporter};
+    tcb_fit_ctx ctx = {(uint64_t)job->seed, job->threads, job->work_dir, job->reporter, &earlier};
     rc = ops->fit(*self, job->seq, &ctx, merr);
+    double spent = earlier + tcb_now_seconds() - t0;
+    if (fit_s) *fit_s = spent;
     if (rc) {
         ensure_error(merr, rc);
         tcb_error_prefix(merr, "fit: ");
         ops->destroy(*self);
         return rc;
     }
-    if (ops->save) save_checkpoint(job, *self, job->checkpoint);
+    if (ops->save) save_checkpoint(job, *self, spent);
     return TCB_OK;
 }
 
@@ -242,11 +265,9 @@ int tcb_cell_run(const tcb_cell_job *job, tcb_cell_result *out, tcb_error *err)
                             k / 2, job->split->pairs[k], job->seq->n_frames);
     if (fill_identity(job, out, &herr)) goto fail;
 
-    double t0 = tcb_now_seconds();
     void *self;
-    int prepared = prepare_method(job, &self, &merr) == TCB_OK;
+    int prepared = prepare_method(job, &self, &out->fit_s, &merr) == TCB_OK;
     double t1 = tcb_now_seconds();
-    out->fit_s = t1 - t0;
     if (prepared) {
         evaluate(job, self, out, &merr, &herr);
         job->ops->destroy(self);
@@ -273,7 +294,7 @@ int tcb_cell_eval_pair(const tcb_cell_job *job, int k, tcb_pair_capture *out, tc
     void *self;
     if (!b.moved || !b.pred) {
         tcb_fail(&herr, TCB_ERR_NOMEM, "out of memory for %zu vertices", nv);
-    } else if (prepare_method(job, &self, &merr) == TCB_OK) {
+    } else if (prepare_method(job, &self, NULL, &merr) == TCB_OK) {
         tcb_pair_record rec;
         tcb_summary sum;
         tcb_summary_init(&sum);

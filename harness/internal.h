@@ -74,6 +74,13 @@ typedef struct tcb_cell_job {
     tcb_reporter reporter;
 } tcb_cell_job;
 
+/* The seconds fitting a cell's model took, stored beside its checkpoint
+ * (<checkpoint>.fit.json) before the checkpoint is published, so a reused
+ * checkpoint still reports its fit time. Load fails (naming the file) when
+ * the record is missing or malformed. (harness/fit_time.c) */
+int tcb_fit_time_save(const char *checkpoint, double fit_s, tcb_error *err);
+int tcb_fit_time_load(const char *checkpoint, double *fit_s, tcb_error *err);
+
 /* Runs one cell into *out (status ok, failed or diverged). A method's error
  * is recorded in the cell, not returned: the return value is non-zero only
  * for harness failures (out of memory, metrics given bad input). Free *out

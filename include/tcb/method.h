@@ -46,6 +46,11 @@ typedef struct tcb_fit_ctx {
                              * keep its training state there to resume a killed
                              * run; --force empties it first */
     tcb_reporter reporter;  /* progress bar and log */
+    double *resumed_fit_s;  /* out, may be NULL: a fit that continues a killed
+                             * one's training state from work_dir sets it to the
+                             * seconds that state cost the earlier processes, so
+                             * the cell's fit_s counts the whole fit. Appended
+                             * last: tables built before it ignore it */
 } tcb_fit_ctx;
 
 typedef struct tcb_method_ops {

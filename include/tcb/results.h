@@ -4,6 +4,8 @@
  *     <run>/config.json                                  the config as run
  *     <run>/cells/<dataset>/<sequence>/<method>/seed_<s>.json
  *     <run>/work/<dataset>/<sequence>/<method>/seed_<s>/  method checkpoints
+ *         (model.ckpt after fit, model.ckpt.fit.json its fit time, and a
+ *         method's own training state while it fits)
  *     <run>/report/                                      written by `tcbench report`
  * A cell file exists only once the cell finished (ok, failed or diverged);
  * `tcbench run` skips cells whose file exists, so a killed run resumes.
@@ -14,6 +16,9 @@
  *     "params": {…}, "seed", "status": "ok"|"failed"|"diverged", "message",
  *     "git_revision", "tcbench_version",
  *     "timings": {"load_s", "fit_s", "eval_s"}, "peak_rss_kb",
+ *         (fit_s is the whole fit across processes: a resumed training adds
+ *         what its checkpoint had cost, a reused model checkpoint reports the
+ *         fit time recorded beside it; peak_rss_kb is this process's)
  *     "split": {"path", "seed", "n_pairs"},
  *     "summary": {"n_pairs", "sl2": {"n","mean","m2"}, "sl2sq": {…},
  *                 "rank": {…}, "auc": {…}, "cd": {…} | null, "pck": [100]},

@@ -124,17 +124,20 @@ static int new_model(atlas_method *a, uint64_t seed, tcb_error *err)
     return TCB_OK;
 }
 
-/* Continues from <work_dir>/train.ckpt when there is one. A checkpoint that
- * cannot be continued (corrupt, other settings) is reported and ignored:
- * training starts over, as the harness does with a bad model checkpoint. */
+/* Continues from <work_dir>/train.ckpt when there is one; *earlier_s gets
+ * the seconds that checkpoint cost (0 when training starts afresh). A
+ * checkpoint that cannot be continued (corrupt, other settings) is reported
+ * and ignored: training starts over, as the harness does with a bad model
+ * checkpoint. */
 static void resume(atlas_method *a, tcb_atlas_trainer *t, const tcb_sequence *seq, const tcb_fit_ctx *ctx,
-                   const char *path)
+                   const char *path, double *earlier_s)
 {
+    *earlier_s = 0;
     if (!path[0] || !tcb_is_file(path)) return;
     tcb_error e = {0};
-    if (tcb_atlas_train_ckpt_load(t, seq, ctx->seed, path, &e) == TCB_OK)
-        tcb_report_log(&ctx->reporter, TCB_LOG_INFO, "%s: resuming training at iteration %lld from %s", a->name,
-                       t->it, path);
+    if (tcb_atlas_train_ckpt_load(t, seq, ctx->seed, path, earlier_s, &e) == TCB_OK)
+        tcb_report_log(&ctx->reporter, TCB_LOG_INFO, "%s: resuming training at iteration %lld from %s (%.0f s in)",
+                       a->name, t->it, path, *earlier_s);
     else
         tcb_report_log(&ctx->reporter, TCB_LOG_WARN, "%s: not resumed (%s); training from the start", a->name,
                        e.msg);
@@ -142,13 +145,14 @@ static void resume(atlas_method *a, tcb_atlas_trainer *t, const tcb_sequence *se
 
 static int train(atlas_method *a, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_error *err)
 {
+    double start = tcb_now_seconds(), earlier = 0;
     tcb_atlas_trainer *t = NULL;
     char ckpt[TCB_PATH_MAX] = "";
     int rc = new_model(a, ctx->seed, err);
     if (!rc && ctx->work_dir && a->checkpoint_every > 0)
         rc = tcb_path_join(ckpt, sizeof ckpt, err, "%s/%s", ctx->work_dir, TCB_ATLAS_TRAIN_CKPT);
     if (!rc) rc = tcb_atlas_trainer_create(&a->cfg, a->model, seq, ctx->seed, &t, err);
-    if (!rc) resume(a, t, seq, ctx, ckpt);
+    if (!rc) resume(a, t, seq, ctx, ckpt, &earlier);
     long long total = a->cfg.iterations;
     while (!rc && t->it < total) {
         double loss;
@@ -159,8 +163,9 @@ static int train(atlas_method *a, const tcb_sequence *seq, const tcb_fit_ctx *ct
         if (!rc && (done % 1000 == 0 || done == total))
             tcb_report_log(&ctx->reporter, TCB_LOG_DEBUG, "%s: iteration %lld loss %.6g", a->name, done, loss);
         if (!rc && ckpt[0] && done % a->checkpoint_every == 0 && done < total)
-            rc = tcb_atlas_train_ckpt_save(t, seq, ctx->seed, ckpt, err);
+            rc = tcb_atlas_train_ckpt_save(t, seq, ctx->seed, earlier + tcb_now_seconds() - start, ckpt, err);
     }
+    if (ctx->resumed_fit_s) *ctx->resumed_fit_s = earlier;
     tcb_atlas_trainer_free(t);
     if (!rc && ckpt[0]) remove(ckpt); /* the harness's model checkpoint supersedes it */
     if (rc) tcb_error_prefix(err, "%s: ", a->name);

@@ -1,12 +1,13 @@
 #include "methods/atlas/train_ckpt.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "tcb/fsutil.h"
 
-#define MAGIC "TCBATRN1"
+#define MAGIC "TCBATRN2"
 
 enum { I_ITERATIONS = 5, N_INTS = 10, N_REALS = 3 };
 static const char *const int_names[N_INTS] = {"latent", "patches", "uv_samples", "loss",
@@ -27,6 +28,7 @@ typedef struct state {
     uint64_t rng[4];
     int64_t adam_t;
     double loss0;
+    double seconds;
 } state;
 
 #define HEAD_BYTES (8 + sizeof(settings) + sizeof(state))
@@ -58,10 +60,10 @@ static int put(tcb_atomic_file *af, uint64_t *h, const void *data, size_t len)
 }
 
 int tcb_atlas_train_ckpt_save(const tcb_atlas_trainer *t, const tcb_sequence *seq,
-                              uint64_t seed, const char *path, tcb_error *err)
+                              uint64_t seed, double seconds, const char *path, tcb_error *err)
 {
     settings s = settings_of(t, seq, seed);
-    state st = {.it = t->it, .adam_t = t->adam.t, .loss0 = t->loss0};
+    state st = {.it = t->it, .adam_t = t->adam.t, .loss0 = t->loss0, .seconds = seconds};
     memcpy(st.rng, t->rng.s, sizeof st.rng);
     size_t n = t->model->nparams;
     tcb_atomic_file af;
@@ -123,7 +125,7 @@ static int check_file(const char *buf, size_t len, size_t n, const settings *wan
 }
 
 int tcb_atlas_train_ckpt_load(tcb_atlas_trainer *t, const tcb_sequence *seq, uint64_t seed,
-                              const char *path, tcb_error *err)
+                              const char *path, double *seconds, tcb_error *err)
 {
     char *buf = NULL;
     size_t len = 0, n = t->model->nparams;
@@ -135,6 +137,8 @@ int tcb_atlas_train_ckpt_load(tcb_atlas_trainer *t, const tcb_sequence *seq, uin
     if (!rc && (st.it < 0 || st.it > want.ints[I_ITERATIONS] || st.adam_t < 0))
         rc = tcb_fail(err, TCB_ERR_INPUT, "%s: iteration %lld outside 0..%lld", path, (long long)st.it,
                       (long long)want.ints[I_ITERATIONS]);
+    if (!rc && !(st.seconds >= 0 && st.seconds < INFINITY))
+        rc = tcb_fail(err, TCB_ERR_INPUT, "%s: training time %g s is not a duration", path, st.seconds);
     if (!rc) {
         const char *p = buf + HEAD_BYTES;
         size_t bytes = n * sizeof(float);
@@ -143,6 +147,7 @@ int tcb_atlas_train_ckpt_load(tcb_atlas_trainer *t, const tcb_sequence *seq, uin
         memcpy(t->adam.v, p + 2 * bytes, bytes);
         memcpy(t->rng.s, st.rng, sizeof st.rng);
         t->it = st.it, t->adam.t = st.adam_t, t->loss0 = st.loss0;
+        *seconds = st.seconds;
     }
     free(buf);
     return rc;

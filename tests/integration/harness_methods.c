@@ -4,7 +4,9 @@
  *
  *   slow_noisy  oracle plus seeded noise, with a checkpoint (save/load), a
  *               reconstruction and an optional sleep per pair (delay_ms), so
- *               a test can kill a run while cells are being evaluated
+ *               a test can kill a run while cells are being evaluated; with
+ *               resumed_fit_s its fit says it continued a training that had
+ *               cost that many seconds before
  *   faulty      fails on purpose: "mode" = "fit" (an error in fit),
  *               "numeric" (TCB_ERR_NUMERIC from transfer at pair `at`),
  *               "nan" (a NaN point from transfer at pair `at`) */
@@ -23,6 +25,7 @@ typedef struct model {
     double offset;   /* drawn in fit from the seed: checks save/load round trips */
     int mode;        /* faulty: 0 fit, 1 numeric, 2 nan */
     int at;          /* faulty: the failing transfer call */
+    double resumed_fit_s; /* slow_noisy: reported through ctx->resumed_fit_s */
     int calls;
 } model;
 
@@ -38,6 +41,8 @@ static int parse(const char *params_json, const char *name, model *m, tcb_error 
         if (strcmp(it->string, "delay_ms") == 0 && cJSON_IsNumber(it)) m->delay_ms = it->valueint;
         else if (strcmp(it->string, "noise") == 0 && cJSON_IsNumber(it)) m->noise = it->valuedouble;
         else if (strcmp(it->string, "at") == 0 && cJSON_IsNumber(it)) m->at = it->valueint;
+        else if (strcmp(it->string, "resumed_fit_s") == 0 && cJSON_IsNumber(it))
+            m->resumed_fit_s = it->valuedouble;
         else if (strcmp(it->string, "mode") == 0 && cJSON_IsString(it)) {
             const char *modes[] = {"fit", "numeric", "nan"};
             m->mode = -1;
@@ -84,6 +89,7 @@ static int sn_fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, t
     tcb_rng rng;
     tcb_rng_seed_stream(&rng, ctx->seed, "slow_noisy/fit");
     m->offset = 1e-3 * tcb_rng_uniform(&rng);
+    if (ctx->resumed_fit_s) *ctx->resumed_fit_s = m->resumed_fit_s;
     tcb_report_progress(&ctx->reporter, 1, 1, "slow_noisy: fit");
     return TCB_OK;
 }

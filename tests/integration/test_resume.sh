@@ -70,6 +70,23 @@ rm "$cell"
 grep -qF "not reused" corrupt.log || { echo "FAIL: corrupt checkpoint not reported"; cat corrupt.log; exit 1; }
 same_cells full killed
 
+# fit_s counts the whole fit: the seconds a method reports for the training
+# it continued, and, when the model checkpoint is reused, the fit time
+# recorded beside it (not the moment it takes to load the model).
+fit_s() { /usr/bin/python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["timings"]["fit_s"])' "$1"; }
+at_least_1000() { /usr/bin/python3 -c 'import sys; sys.exit(0 if float(sys.argv[1]) >= 1000 else 1)' "$1"; }
+sed 's/"noise": 0.01/"noise": 0.01, "resumed_fit_s": 1000/' grid.json > resumed.json
+"$TCBENCH" run resumed.json --out resumed --only slow --quiet
+rcell=resumed/cells/synth/quadruped_trot/slow/seed_1.json
+at_least_1000 "$(fit_s "$rcell")" || { echo "FAIL: fit_s $(fit_s "$rcell") leaves out the resumed 1000 s"; exit 1; }
+rm "$rcell"
+"$TCBENCH" run resumed.json --out resumed --only slow --quiet 2> reused.log
+at_least_1000 "$(fit_s "$rcell")" ||
+    { echo "FAIL: a reused checkpoint reports fit_s $(fit_s "$rcell")"; cat reused.log; exit 1; }
+rm "$rcell" resumed/work/synth/quadruped_trot/slow/seed_1/model.ckpt.fit.json
+"$TCBENCH" run resumed.json --out resumed --only slow 2> unrecorded.log
+grep -qF "fit time unknown" unrecorded.log || { echo "FAIL: a missing fit record is not said"; cat unrecorded.log; exit 1; }
+
 # Cells made with other settings are not silently mixed in.
 sed 's/"noise": 0.01/"noise": 0.02/' grid.json > changed.json
 rc=0

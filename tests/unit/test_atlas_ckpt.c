@@ -80,7 +80,8 @@ static void join(char *out, const char *dir, const char *name)
 static void ckpt_path(const char *dir, char *out) { join(out, dir, TCB_ATLAS_TRAIN_CKPT); }
 
 /* Stop at 10 of 24, save, continue in a fresh trainer whose model starts
- * from other weights: weights, moments and random stream match. */
+ * from other weights: weights, moments and random stream match, and the
+ * training time stamp comes back. */
 static void test_trainer_resume_bit_identical(void **state)
 {
     const char *dir = *state;
@@ -92,12 +93,14 @@ static void test_trainer_resume_bit_identical(void **state)
     steps(ta, &s, ITERS);
     steps(tb, &s, 10);
     tcb_error err = {0};
-    assert_int_equal(tcb_atlas_train_ckpt_save(tb, &s, SEED, path, &err), TCB_OK);
+    assert_int_equal(tcb_atlas_train_ckpt_save(tb, &s, SEED, 12.5, path, &err), TCB_OK);
     tcb_atlas_trainer_free(tb);
 
     tcb_atlas_trainer *tc = new_trainer(&tiny_mca, mc, &s);
-    assert_int_equal(tcb_atlas_train_ckpt_load(tc, &s, SEED, path, &err), TCB_OK);
+    double seconds = -1;
+    assert_int_equal(tcb_atlas_train_ckpt_load(tc, &s, SEED, path, &seconds, &err), TCB_OK);
     assert_int_equal(tc->it, 10);
+    assert_true(seconds == 12.5);
     steps(tc, &s, ITERS);
     size_t bytes = ma->nparams * sizeof(float);
     assert_memory_equal(ma->params, mc->params, bytes);
@@ -123,14 +126,18 @@ static void collect(void *ctx, tcb_log_level level, const char *msg)
     snprintf(b->text + used, sizeof b->text - used, "%s\n", msg);
 }
 
+/* Fits mca in `work` and returns its saved model; *resumed_s gets what the
+ * fit reports through ctx->resumed_fit_s. */
 static char *fit_and_save(const char *params, const tcb_sequence *s, const char *work, log_buf *log,
-                          size_t *len)
+                          size_t *len, double *resumed_s)
 {
     const tcb_method_ops *ops = tcb_registry_find("mca");
     void *self = NULL;
     tcb_error err = {0};
     assert_int_equal(ops->create(params, &self, &err), TCB_OK);
-    tcb_fit_ctx ctx = {.seed = SEED, .n_threads = 1, .work_dir = work, .reporter = {.log = collect, .ctx = log}};
+    *resumed_s = -1;
+    tcb_fit_ctx ctx = {.seed = SEED, .n_threads = 1, .work_dir = work, .reporter = {.log = collect, .ctx = log},
+                       .resumed_fit_s = resumed_s};
     if (ops->fit(self, s, &ctx, &err)) fail_msg("fit: %s", err.msg);
     char path[TCB_PATH_MAX], *buf;
     join(path, work, "model.ckpt");
@@ -142,8 +149,9 @@ static char *fit_and_save(const char *params, const tcb_sequence *s, const char 
 
 /* The method's fit: uninterrupted in one directory; in another, a training
  * state at iteration 10 is left where a killed fit would have left it, and
- * the fit continues from it (its log says so) to the same weights, then
- * removes it. A corrupt state is reported and training starts over. */
+ * the fit continues from it (its log says so) to the same weights, reports
+ * the state's training time as resumed, then removes it. A corrupt state is
+ * reported and training starts over. */
 static void test_fit_resumes(void **state)
 {
     const char *dir = *state;
@@ -157,26 +165,30 @@ static void test_fit_resumes(void **state)
     assert_int_equal(tcb_mkdirs(killed, &err), TCB_OK);
     log_buf log_full = {""}, log_killed = {""}, log_corrupt = {""};
     size_t la, lb, lc;
-    char *a = fit_and_save(params, &s, full, &log_full, &la);
+    double resumed;
+    char *a = fit_and_save(params, &s, full, &log_full, &la, &resumed);
     ckpt_path(full, path);
     assert_false(tcb_is_file(path));
     assert_null(strstr(log_full.text, "resuming"));
+    assert_true(resumed == 0);
 
     tcb_atlas_model *m = new_model(TINY_C, SEED);
     tcb_atlas_trainer *t = new_trainer(&tiny_mca, m, &s);
     steps(t, &s, 10);
     ckpt_path(killed, path);
-    assert_int_equal(tcb_atlas_train_ckpt_save(t, &s, SEED, path, &err), TCB_OK);
-    char *b = fit_and_save(params, &s, killed, &log_killed, &lb);
+    assert_int_equal(tcb_atlas_train_ckpt_save(t, &s, SEED, 1234.5, path, &err), TCB_OK);
+    char *b = fit_and_save(params, &s, killed, &log_killed, &lb, &resumed);
     assert_non_null(strstr(log_killed.text, "resuming training at iteration 10"));
+    assert_true(resumed == 1234.5);
     assert_false(tcb_is_file(path));
     assert_int_equal(la, lb);
     assert_memory_equal(a, b, la);
 
     char junk[TCB_PATH_MAX];
-    tu_write_text(killed, TCB_ATLAS_TRAIN_CKPT, "TCBATRN1 but nothing after it", junk, sizeof junk);
-    char *c = fit_and_save(params, &s, killed, &log_corrupt, &lc);
+    tu_write_text(killed, TCB_ATLAS_TRAIN_CKPT, "TCBATRN2 but nothing after it", junk, sizeof junk);
+    char *c = fit_and_save(params, &s, killed, &log_corrupt, &lc, &resumed);
     assert_non_null(strstr(log_corrupt.text, "not resumed"));
+    assert_true(resumed == 0);
     assert_int_equal(la, lc);
     assert_memory_equal(a, c, la);
     free(a), free(b), free(c);
@@ -194,7 +206,9 @@ static void expect_refused(tcb_atlas_trainer *t, const tcb_sequence *s, const ch
     memcpy(before, t->model->params, bytes);
     long long it = t->it;
     tcb_error err = {0};
-    assert_int_equal(tcb_atlas_train_ckpt_load(t, s, SEED, path, &err), TCB_ERR_INPUT);
+    double seconds = -1;
+    assert_int_equal(tcb_atlas_train_ckpt_load(t, s, SEED, path, &seconds, &err), TCB_ERR_INPUT);
+    assert_true(seconds == -1);
     if (!strstr(err.msg, want)) fail_msg("expected '%s' in: %s", want, err.msg);
     assert_non_null(strstr(err.msg, path));
     assert_memory_equal(before, t->model->params, bytes);
@@ -219,7 +233,7 @@ static void test_damaged_and_foreign_refused(void **state)
     tcb_atlas_model *m = new_model(TINY_C, SEED);
     tcb_atlas_trainer *t = new_trainer(&tiny_mca, m, &s);
     steps(t, &s, 3);
-    assert_int_equal(tcb_atlas_train_ckpt_save(t, &s, SEED, path, &err), TCB_OK);
+    assert_int_equal(tcb_atlas_train_ckpt_save(t, &s, SEED, 60, path, &err), TCB_OK);
     assert_int_equal(tcb_read_file(path, &buf, &len, &err), TCB_OK);
     tcb_atlas_trainer_free(t);
     t = new_trainer(&tiny_mca, m, &s);
@@ -233,10 +247,17 @@ static void test_damaged_and_foreign_refused(void **state)
     memcpy(buf, "TCBATLS1", 8);
     rewrite(path, buf, len);
     expect_refused(t, &s, path, "magic");
-    memcpy(buf, "TCBATRN1", 8);
+    memcpy(buf, "TCBATRN1", 8); /* the format before training times were kept */
     rewrite(path, buf, len);
-    assert_int_equal(tcb_atlas_train_ckpt_load(t, &s, SEED, path, &err), TCB_OK);
+    expect_refused(t, &s, path, "magic");
+    memcpy(buf, "TCBATRN2", 8);
+    rewrite(path, buf, len);
+    double seconds;
+    assert_int_equal(tcb_atlas_train_ckpt_load(t, &s, SEED, path, &seconds, &err), TCB_OK);
     assert_int_equal(t->it, 3);
+    assert_true(seconds == 60);
+    assert_int_equal(tcb_atlas_train_ckpt_save(t, &s, SEED, -1, path, &err), TCB_OK);
+    expect_refused(t, &s, path, "not a duration");
     tcb_atlas_trainer_free(t);
 
     tcb_atlas_train_cfg longer = tiny_mca;
