@@ -139,19 +139,24 @@ typedef struct candidate {
     int *best;
 } candidate;
 
-/* Marks, per metric, every candidate whose displayed value is the best. */
+/* Marks, per metric, every candidate whose displayed value is the best.
+ * A value with nothing to compare against is no one's best: a seed only one
+ * method ran on stays unmarked rather than bold in every column. */
 static void mark_best(const candidate *c, int n)
 {
     for (int m = 0; m < TCB_N_METRICS; m++) {
         const tcb_rpt_metric_def *d = &tcb_rpt_metrics[m];
         double best = d->lower_is_better ? INFINITY : -INFINITY;
+        int compared = 0;
         for (int k = 0; k < n; k++) {
             if (!c[k].has[m]) continue;
             double v = displayed(c[k].mean[m], d->decimals);
             if (d->lower_is_better ? v < best : v > best) best = v;
+            compared++;
         }
         for (int k = 0; k < n; k++)
-            c[k].best[m] = c[k].has[m] && displayed(c[k].mean[m], d->decimals) == best;
+            c[k].best[m] = compared > 1 && c[k].has[m] &&
+                           displayed(c[k].mean[m], d->decimals) == best;
     }
 }
 
