@@ -37,9 +37,10 @@ int tcb_atlas_train_ckpt_save(const tcb_atlas_trainer *t, const tcb_sequence *se
                               uint64_t seed, double seconds, const char *path, tcb_error *err);
 
 /* Restores t (created with the same settings, model and sequence) from the
- * file and *seconds from its time stamp. TCB_ERR_INPUT names the file and the reason: bad magic, truncated,
- * checksum mismatch, or the first setting that differs. On failure t and
- * *seconds are unchanged. */
+ * file, and *seconds from its time stamp. TCB_ERR_INPUT names the file and
+ * the reason: bad magic, truncated, checksum mismatch, the first setting
+ * that differs, an iteration out of range or a time that is not a duration.
+ * On failure t and *seconds are unchanged. */
 int tcb_atlas_train_ckpt_load(tcb_atlas_trainer *t, const tcb_sequence *seq, uint64_t seed,
                               const char *path, double *seconds, tcb_error *err);
 
