@@ -84,7 +84,7 @@ static void layer1_forward(const tcb_atlas_decoder_cache *c, const float *uv, in
             for (int j = 0; j < h1; j++) {
                 float sig, s = sz[j] + u * wu[j] + v * wv[j];
                 s1[j] = s;
-                a[j] = tcb_atlas_softplus(s, &sig);
+                a[j] = tcb_softplus(s, &sig);
                 au[j] = sig * wu[j];
                 av[j] = sig * wv[j];
             }
@@ -93,7 +93,7 @@ static void layer1_forward(const tcb_atlas_decoder_cache *c, const float *uv, in
             for (int j = 0; j < h1; j++) {
                 float sig, s = sz[j] + u * wu[j] + v * wv[j];
                 s1[j] = s;
-                a[j] = tcb_atlas_softplus(s, &sig);
+                a[j] = tcb_softplus(s, &sig);
             }
         }
     }
@@ -115,11 +115,11 @@ void tcb_atlas_decoder_forward(const tcb_atlas_decoder *d, tcb_atlas_decoder_cac
     cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, c->nz, h1, C, 1.0f, z, C, W1 + 2, h1,
                 1.0f, c->sz, h1);
     layer1_forward(c, uv, nt, h1);
-    tcb_atlas_linear_forward(c->x2, c->a1, d->l[1].W, d->l[1].b, R, nt, h1, h2);
-    tcb_atlas_softplus_forward(c->a2, c->x2, R, nt, h2);
-    tcb_atlas_linear_forward(c->x3, c->a2, d->l[2].W, d->l[2].b, R, nt, h2, h3);
-    tcb_atlas_softplus_forward(c->a3, c->x3, R, nt, h3);
-    tcb_atlas_linear_forward(out, c->a3, d->l[3].W, d->l[3].b, R, nt, h3, 3);
+    tcb_linear_forward(c->x2, c->a1, d->l[1].W, d->l[1].b, R, nt, h1, h2);
+    tcb_softplus_forward(c->a2, c->x2, R, nt, h2);
+    tcb_linear_forward(c->x3, c->a2, d->l[2].W, d->l[2].b, R, nt, h2, h3);
+    tcb_softplus_forward(c->a3, c->x3, R, nt, h3);
+    tcb_linear_forward(out, c->a3, d->l[3].W, d->l[3].b, R, nt, h3, 3);
 }
 
 /* Layer 1 backward, given da = ∂L/∂[a1; a1_u; a1_v] (stacked): per element
@@ -142,7 +142,7 @@ static void layer1_backward_rows(const tcb_atlas_decoder_cache *c, const float *
         if (nt) {
 #pragma omp simd
             for (int j = 0; j < h1; j++) {
-                float curv, sig = tcb_atlas_sigmoid(s1[j], &curv);
+                float curv, sig = tcb_sigmoid(s1[j], &curv);
                 float d = sig * g[j] + curv * (wu[j] * gu[j] + wv[j] * gv[j]);
                 ds[j] = d;
                 pu[j] = sig * gu[j] + d * u;
@@ -151,7 +151,7 @@ static void layer1_backward_rows(const tcb_atlas_decoder_cache *c, const float *
         } else {
 #pragma omp simd
             for (int j = 0; j < h1; j++) {
-                float curv, d = tcb_atlas_sigmoid(s1[j], &curv) * g[j];
+                float curv, d = tcb_sigmoid(s1[j], &curv) * g[j];
                 ds[j] = d;
                 pu[j] = d * u;
                 pv[j] = d * v;
@@ -171,8 +171,8 @@ static void layer1_backward(const tcb_atlas_decoder *d, const tcb_atlas_decoder 
     layer1_backward_rows(c, uv, s->da, s->dx, nt, h1);
     /* the uv columns of W1 */
     memset(s->dw, 0, 2 * (size_t)h1 * sizeof(float));
-    tcb_atlas_colsum_acc(s->dw, s->dx + blk, R, h1);
-    tcb_atlas_colsum_acc(s->dw + h1, s->dx + 2 * blk, R, h1);
+    tcb_colsum_acc(s->dw, s->dx + blk, R, h1);
+    tcb_colsum_acc(s->dw + h1, s->dx + 2 * blk, R, h1);
     for (int j = 0; j < h1; j++) {
         gW1[(size_t)j * h1] += s->dw[j];
         gW1[(size_t)j * h1 + 1] += s->dw[h1 + j];
@@ -180,8 +180,8 @@ static void layer1_backward(const tcb_atlas_decoder *d, const tcb_atlas_decoder 
     /* the z part: ds_z = Σ over each shape's samples of ds */
     memset(s->dsz, 0, (size_t)nz * h1 * sizeof(float));
     for (int b = 0; b < nz; b++)
-        tcb_atlas_colsum_acc(s->dsz + (size_t)b * h1, s->dx + (size_t)b * m * h1, m, h1);
-    tcb_atlas_colsum_acc(grad->l[0].b, s->dsz, nz, h1);
+        tcb_colsum_acc(s->dsz + (size_t)b * h1, s->dx + (size_t)b * m * h1, m, h1);
+    tcb_colsum_acc(grad->l[0].b, s->dsz, nz, h1);
     cblas_sgemm(CblasRowMajor, CblasTrans, CblasNoTrans, h1, C, nz, 1.0f, s->dsz, h1, z, C, 1.0f,
                 gW1 + 2, h1);
     cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, nz, C, h1, 1.0f, s->dsz, h1, W1 + 2,
@@ -206,11 +206,11 @@ void tcb_atlas_decoder_backward(const tcb_atlas_decoder *d, const tcb_atlas_deco
                                 const float *dout, int nt, float *dz, float *duv)
 {
     int C = c->C, h1 = C + 2, h2 = h1 / 2, h3 = h1 / 4, R = c->nz * c->m;
-    const tcb_atlas_linear *l = d->l, *g = grad->l;
-    tcb_atlas_linear_backward(s->da, g[3].W, g[3].b, dout, c->a3, l[3].W, R, nt, h3, 3);
-    tcb_atlas_softplus_backward(s->dx, s->da, c->x3, R, nt, h3);
-    tcb_atlas_linear_backward(s->da, g[2].W, g[2].b, s->dx, c->a2, l[2].W, R, nt, h2, h3);
-    tcb_atlas_softplus_backward(s->dx, s->da, c->x2, R, nt, h2);
-    tcb_atlas_linear_backward(s->da, g[1].W, g[1].b, s->dx, c->a1, l[1].W, R, nt, h1, h2);
+    const tcb_linear *l = d->l, *g = grad->l;
+    tcb_linear_backward(s->da, g[3].W, g[3].b, dout, c->a3, l[3].W, R, nt, h3, 3);
+    tcb_softplus_backward(s->dx, s->da, c->x3, R, nt, h3);
+    tcb_linear_backward(s->da, g[2].W, g[2].b, s->dx, c->a2, l[2].W, R, nt, h2, h3);
+    tcb_softplus_backward(s->dx, s->da, c->x2, R, nt, h2);
+    tcb_linear_backward(s->da, g[1].W, g[1].b, s->dx, c->a1, l[1].W, R, nt, h1, h2);
     layer1_backward(d, grad, c, s, z, uv, nt, dz, duv);
 }

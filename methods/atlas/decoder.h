@@ -17,13 +17,13 @@
 #ifndef TCB_ATLAS_DECODER_H
 #define TCB_ATLAS_DECODER_H
 
-#include "methods/atlas/layers.h"
+#include "neural/layers.h"
 #include "tcb/error.h"
 
 #define TCB_ATLAS_DEC_LAYERS 4
 
 typedef struct tcb_atlas_decoder {
-    tcb_atlas_linear l[TCB_ATLAS_DEC_LAYERS];
+    tcb_linear l[TCB_ATLAS_DEC_LAYERS];
 } tcb_atlas_decoder;
 
 /* in/out widths of layer k for latent size C. */

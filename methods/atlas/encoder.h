@@ -6,7 +6,7 @@
 
 #include <stdint.h>
 
-#include "methods/atlas/layers.h"
+#include "neural/layers.h"
 #include "tcb/error.h"
 
 #define TCB_ATLAS_ENC_LAYERS 5
@@ -14,7 +14,7 @@
 /* Layers in order: conv1 3→64, conv2 64→128, conv3 128→C (1×1 convolutions,
  * i.e. per-point linear layers), fc1 C→C, fc2 C→C. */
 typedef struct tcb_atlas_encoder {
-    tcb_atlas_linear l[TCB_ATLAS_ENC_LAYERS];
+    tcb_linear l[TCB_ATLAS_ENC_LAYERS];
 } tcb_atlas_encoder;
 
 /* in/out widths of layer k for latent size C. */

@@ -34,7 +34,7 @@ static void layer_info(int C, int k, char *name, int *in, int *out)
     tcb_atlas_decoder_dims(C, j, in, out);
 }
 
-static tcb_atlas_linear *layer_view(tcb_atlas_encoder *enc, tcb_atlas_decoder *dec, int k)
+static tcb_linear *layer_view(tcb_atlas_encoder *enc, tcb_atlas_decoder *dec, int k)
 {
     if (k < TCB_ATLAS_ENC_LAYERS) return &enc->l[k];
     k -= TCB_ATLAS_ENC_LAYERS;
@@ -48,7 +48,7 @@ static size_t bind(int C, int P, float *base, tcb_atlas_encoder *enc, tcb_atlas_
         char name[NAME_LEN];
         int in, out;
         layer_info(C, k, name, &in, &out);
-        tcb_atlas_linear_bind(layer_view(enc, dec, k), base, &off, in, out);
+        tcb_linear_bind(layer_view(enc, dec, k), base, &off, in, out);
     }
     return off;
 }
@@ -102,7 +102,7 @@ void tcb_atlas_model_free(tcb_atlas_model *m)
 void tcb_atlas_model_init(tcb_atlas_model *m, tcb_rng *rng)
 {
     for (int k = 0; k < layer_count(m->P); k++) {
-        tcb_atlas_linear *l = layer_view(&m->enc, m->dec, k);
+        tcb_linear *l = layer_view(&m->enc, m->dec, k);
         double bound = 1.0 / sqrt((double)l->in);
         size_t nw = (size_t)l->in * l->out;
         for (size_t i = 0; i < nw; i++) l->W[i] = (float)((2.0 * tcb_rng_uniform(rng) - 1.0) * bound);

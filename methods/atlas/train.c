@@ -37,7 +37,7 @@ int tcb_atlas_trainer_create(const tcb_atlas_train_cfg *cfg, tcb_atlas_model *mo
     int ok = t->clouds && t->uv;
     for (size_t k = 0; k < sizeof bufs / sizeof bufs[0]; k++) ok &= (*bufs[k] = malloc(bm3 * sizeof(float))) != NULL;
     int rc = ok ? TCB_OK : tcb_fail(err, TCB_ERR_NOMEM, "atlas: out of memory for training buffers");
-    if (!rc) rc = tcb_atlas_adam_init(&t->adam, model->nparams, err);
+    if (!rc) rc = tcb_adam_init(&t->adam, model->nparams, err);
     if (!rc) rc = tcb_atlas_work_create(model, TCB_ATLAS_BATCH, t->N, cfg->M, &t->work, err);
     if (rc) {
         tcb_atlas_trainer_free(t);
@@ -51,7 +51,7 @@ void tcb_atlas_trainer_free(tcb_atlas_trainer *t)
 {
     if (!t) return;
     tcb_atlas_work_free(t->work);
-    tcb_atlas_adam_free(&t->adam);
+    tcb_adam_free(&t->adam);
     free(t->clouds), free(t->uv);
     free(t->phi), free(t->phi_u), free(t->phi_v);
     free(t->dphi), free(t->dphi_u), free(t->dphi_v);
@@ -135,8 +135,8 @@ int tcb_atlas_train_step(tcb_atlas_trainer *t, const tcb_sequence *seq, double *
         tcb_error_prefix(err, "iteration %lld: ", t->it);
         return rc;
     }
-    tcb_atlas_adam_step(&t->adam, t->model->params, t->model->grads,
-                        tcb_atlas_lr_at(t->cfg.lr, t->it, t->cfg.iterations));
+    tcb_adam_step(&t->adam, t->model->params, t->model->grads,
+                        tcb_lr_at(t->cfg.lr, t->it, t->cfg.iterations));
     t->it++;
     return TCB_OK;
 }

@@ -6,7 +6,7 @@
 
 #include <stdint.h>
 
-#include "methods/atlas/adam.h"
+#include "neural/adam.h"
 #include "methods/atlas/model.h"
 #include "tcb/error.h"
 #include "tcb/rng.h"
@@ -34,7 +34,7 @@ typedef struct tcb_atlas_trainer {
     tcb_atlas_train_cfg cfg;
     tcb_atlas_model *model; /* borrowed */
     tcb_atlas_work *work;
-    tcb_atlas_adam adam;
+    tcb_adam adam;
     tcb_rng rng;            /* pairs, clouds and UV samples */
     long long it;           /* iterations done */
     double loss0;           /* the loss of iteration 0 */

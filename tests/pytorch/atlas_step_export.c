@@ -73,7 +73,7 @@ static void init_model(tcb_atlas_model *m)
     tcb_rng_seed_stream(&rng, 2024, "tests/pytorch/atlas_step");
     tcb_atlas_model_init(m, &rng);
     for (int p = 0; p < m->P; p++) {
-        tcb_atlas_linear *fc1 = &m->dec[p].l[0], *fc4 = &m->dec[p].l[TCB_ATLAS_DEC_LAYERS - 1];
+        tcb_linear *fc1 = &m->dec[p].l[0], *fc4 = &m->dec[p].l[TCB_ATLAS_DEC_LAYERS - 1];
         for (size_t i = 0; i < (size_t)fc1->in * fc1->out; i++) fc1->W[i] *= FC1_GAIN;
         for (size_t i = 0; i < (size_t)fc4->in * fc4->out; i++) fc4->W[i] *= FC4_GAIN;
     }
@@ -117,7 +117,7 @@ static int export_step(const char *root, int k, const tcb_sequence *seq, tcb_err
     if (!rc) rc = tcb_atlas_trainer_create(&cfg, m, seq, 7, &t, err);
     if (!rc) rc = tcb_atlas_train_step(t, seq, &loss, err);
     if (!rc) rc = export_model(m, dir, "updated", err);
-    double lr = tcb_atlas_lr_at(cfg.lr, 0, cfg.iterations); /* the lr of iteration 0 */
+    double lr = tcb_lr_at(cfg.lr, 0, cfg.iterations); /* the lr of iteration 0 */
     if (!rc && (write_case(dir, methods[k].name, t, loss, lr) |
                 export_f32(dir, "grads.f32", m->grads, m->nparams) |
                 export_f32(dir, "clouds.f32", t->clouds, (size_t)TCB_ATLAS_BATCH * N * 3) |

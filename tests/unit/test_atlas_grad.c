@@ -108,7 +108,7 @@ typedef struct {
 } ref_layer;
 
 /* The double view of a float layer l of model m, inside pd (same layout). */
-static ref_layer ref_view(const tcb_atlas_model *m, const double *pd, const tcb_atlas_linear *l)
+static ref_layer ref_view(const tcb_atlas_model *m, const double *pd, const tcb_linear *l)
 {
     return (ref_layer){pd + (l->W - m->params), pd + (l->b - m->params), l->in, l->out};
 }
@@ -209,20 +209,20 @@ static void check_linear(int n, int in, int out, tcb_rng *rng)
     lin_ctx c = {to_double(x, (size_t)rows * in), to_double(W, (size_t)out * in),
                  to_double(b, out), to_double(w, (size_t)rows * out), n, 2, in, out};
 
-    tcb_atlas_linear_forward(y, x, W, b, n, 2, in, out);
+    tcb_linear_forward(y, x, W, b, n, 2, in, out);
     double *yref = malloc((size_t)rows * out * sizeof(double));
     ref_layer L = {c.W, c.b, in, out};
     for (int r = 0; r < rows; r++) ref_affine(yref + (size_t)r * out, L, c.x + (size_t)r * in, r < n);
     check_forward("linear y", y, yref, (size_t)rows * out);
 
-    tcb_atlas_linear_backward(dx, dW, db, w, x, W, n, 2, in, out);
+    tcb_linear_backward(dx, dW, db, w, x, W, n, 2, in, out);
     check_grad("linear dW", lin_objective, &c, c.W, dW, (size_t)out * in, 24, rng);
     check_grad("linear db", lin_objective, &c, c.b, db, out, 24, rng);
     check_grad("linear dx", lin_objective, &c, c.x, dx, (size_t)rows * in, 24, rng);
 
     /* accumulation: a second backward doubles dW and db */
     float dW0 = dW[1], db0 = db[0];
-    tcb_atlas_linear_backward(NULL, dW, db, w, x, W, n, 2, in, out);
+    tcb_linear_backward(NULL, dW, db, w, x, W, n, 2, in, out);
     assert_near(dW[1], 2.0f * dW0, 1e-6 * fabs(dW0));
     assert_near(db[0], 2.0f * db0, 1e-6 * fabs(db0));
 
@@ -265,10 +265,10 @@ static void test_relu(void **state)
     float x[n], y[n], w[n], dx[n];
     fill_uniform(&rng, x, n, -1, 1);
     fill_uniform(&rng, w, n, -1, 1);
-    tcb_atlas_relu_forward(y, x, n);
+    tcb_relu_forward(y, x, n);
     relu_ctx c = {to_double(x, n), to_double(w, n), n};
     for (int i = 0; i < n; i++) assert_true(y[i] == (x[i] > 0 ? x[i] : 0.0f));
-    tcb_atlas_relu_backward(dx, w, y, n);
+    tcb_relu_backward(dx, w, y, n);
     check_grad("relu dx", relu_objective, &c, c.x, dx, n, n, &rng);
     free(c.x), free((void *)c.w);
 }
@@ -311,17 +311,17 @@ static void test_softplus(void **state)
     x[0] = 25.0f;  /* linear branch: softplus′ = 1, softplus′′ = 0 */
     x[1] = -30.0f; /* deep in the exponential tail */
     x[2] = 19.5f;  /* just below the threshold */
-    tcb_atlas_softplus_forward(y, x, n, 2, d);
+    tcb_softplus_forward(y, x, n, 2, d);
     sp_ctx c = {to_double(x, len), to_double(w, len), n, d};
     double yref[len];
     ref_softplus_stack(c.x, yref, n, d);
     check_forward("softplus y", y, yref, len);
     assert_true(y[0] == 25.0f && y[n * d] == x[n * d]);
-    tcb_atlas_softplus_backward(dx, w, x, n, 2, d);
+    tcb_softplus_backward(dx, w, x, n, 2, d);
     check_grad("softplus dx", sp_objective, &c, c.x, dx, len, len, &rng);
     /* in place, as the decoder may call it */
     memcpy(y, w, sizeof y);
-    tcb_atlas_softplus_backward(y, y, x, n, 2, d);
+    tcb_softplus_backward(y, y, x, n, 2, d);
     assert_memory_equal(y, dx, sizeof y);
     free(c.x), free((void *)c.w);
 }
@@ -360,7 +360,7 @@ static void test_maxpool(void **state)
     int32_t arg[nb * out];
     fill_uniform(&rng, h, nb * n * out, -1, 1);
     h[4 * out] = h[7 * out] = 5.0f; /* a tie in set 0, channel 0: the first point wins */
-    tcb_atlas_maxpool_forward(y, arg, h, nb, n, out);
+    tcb_maxpool_forward(y, arg, h, nb, n, out);
     assert_int_equal(arg[0], 4);
     for (int b = 0; b < nb; b++)
         for (int j = 0; j < out; j++) {
@@ -376,9 +376,9 @@ static void test_maxpool(void **state)
     fill_uniform(&rng, W, out * in, -1, 1);
     fill_uniform(&rng, bias, out, -1, 1);
     fill_uniform(&rng, w, nb * out, -1, 1);
-    tcb_atlas_linear_forward(h, x, W, bias, nb * n, 0, in, out);
-    tcb_atlas_maxpool_forward(y, arg, h, nb, n, out);
-    tcb_atlas_maxpool_linear_backward(dx, dW, db, w, arg, x, W, nb, n, in, out);
+    tcb_linear_forward(h, x, W, bias, nb * n, 0, in, out);
+    tcb_maxpool_forward(y, arg, h, nb, n, out);
+    tcb_maxpool_linear_backward(dx, dW, db, w, arg, x, W, nb, n, in, out);
     pool_ctx c = {to_double(x, nb * n * in), to_double(W, out * in), to_double(bias, out),
                   to_double(w, nb * out), nb, n, in, out};
     check_grad("pooled linear dW", pool_objective, &c, c.W, dW, out * in, out * in, &rng);
@@ -495,7 +495,7 @@ static void check_decoder_grad(int nt)
     dec_ctx c = {f.m, to_double(f.m->params, f.m->nparams), to_double(f.z, B * C),
                  to_double(f.uv, MP * 2), to_double(f.coef, 3 * B * MP * 3)};
     for (int k = 0; k < TCB_ATLAS_DEC_LAYERS; k++) {
-        const tcb_atlas_linear *l = &f.m->dec[0].l[k], *g = &f.m->gdec[0].l[k];
+        const tcb_linear *l = &f.m->dec[0].l[k], *g = &f.m->gdec[0].l[k];
         char what[64];
         snprintf(what, sizeof what, "decoder fc%d.weight (nt=%d)", k + 1, nt);
         check_grad(what, dec_objective, &c, c.pd + (l->W - f.m->params), g->W,
@@ -504,7 +504,7 @@ static void check_decoder_grad(int nt)
         check_grad(what, dec_objective, &c, c.pd + (l->b - f.m->params), g->b, l->out, 8, &rng);
     }
     /* layer 1's uv columns, whose gradient has the tangent term */
-    const tcb_atlas_linear *l1 = &f.m->dec[0].l[0];
+    const tcb_linear *l1 = &f.m->dec[0].l[0];
     for (int col = 0; col < 2; col++)
         for (int r = 0; r < l1->out; r += 5) {
             size_t at = (size_t)r * l1->in + col;
@@ -562,7 +562,7 @@ static void test_encoder_grad(void **state)
     check_forward("encoder z", cache.z, zref, B * C);
     tcb_atlas_encoder_backward(&m->enc, &m->genc, &cache, w);
     for (int k = 0; k < TCB_ATLAS_ENC_LAYERS; k++) {
-        const tcb_atlas_linear *l = &m->enc.l[k], *g = &m->genc.l[k];
+        const tcb_linear *l = &m->enc.l[k], *g = &m->genc.l[k];
         char what[64];
         snprintf(what, sizeof what, "encoder layer %d weight", k);
         check_grad(what, enc_objective, &c, c.pd + (l->W - m->params), g->W,
@@ -636,7 +636,7 @@ static void test_model_grad(void **state)
     assert_int_equal(tcb_atlas_model_backward(m, w, coef[0], coef[1], coef[2], &err), TCB_OK);
     int nlayers = TCB_ATLAS_ENC_LAYERS + P * TCB_ATLAS_DEC_LAYERS;
     for (int k = 0; k < nlayers; k++) {
-        const tcb_atlas_linear *l =
+        const tcb_linear *l =
             k < TCB_ATLAS_ENC_LAYERS ? &m->enc.l[k]
                                      : &m->dec[(k - TCB_ATLAS_ENC_LAYERS) / TCB_ATLAS_DEC_LAYERS]
                                             .l[(k - TCB_ATLAS_ENC_LAYERS) % TCB_ATLAS_DEC_LAYERS];

@@ -48,7 +48,7 @@ static void test_param_count(void **state)
     tcb_atlas_model *m = make_model(C, P, 1);
     size_t off = 0;
     for (int k = 0; k < TCB_ATLAS_ENC_LAYERS + P * TCB_ATLAS_DEC_LAYERS; k++) {
-        const tcb_atlas_linear *l =
+        const tcb_linear *l =
             k < TCB_ATLAS_ENC_LAYERS ? &m->enc.l[k]
                                      : &m->dec[(k - TCB_ATLAS_ENC_LAYERS) / TCB_ATLAS_DEC_LAYERS]
                                             .l[(k - TCB_ATLAS_ENC_LAYERS) % TCB_ATLAS_DEC_LAYERS];
@@ -75,10 +75,10 @@ static void test_init(void **state)
     tcb_atlas_model *other = make_model(64, 1, 2);
     assert_memory_equal(m->params, same->params, m->nparams * sizeof(float));
     assert_memory_not_equal(m->params, other->params, m->nparams * sizeof(float));
-    const tcb_atlas_linear *ls[] = {&m->enc.l[0], &m->enc.l[2], &m->enc.l[4], &m->dec[0].l[0],
+    const tcb_linear *ls[] = {&m->enc.l[0], &m->enc.l[2], &m->enc.l[4], &m->dec[0].l[0],
                                     &m->dec[0].l[3]};
     for (size_t t = 0; t < sizeof ls / sizeof *ls; t++) {
-        const tcb_atlas_linear *l = ls[t];
+        const tcb_linear *l = ls[t];
         double bound = 1.0 / sqrt(l->in), mx = 0.0, sum = 0.0;
         size_t n = (size_t)l->in * l->out;
         for (size_t i = 0; i < n; i++) {
@@ -270,8 +270,8 @@ static void test_softplus_accuracy(void **state)
     double worst_sp = 0.0, worst_sig = 0.0, worst_curv = 0.0;
     for (double s = -100.0; s <= 40.0; s += 1.0 / 1024) {
         float sig, curv;
-        float sp = tcb_atlas_softplus((float)s, &sig);
-        float sig2 = tcb_atlas_sigmoid((float)s, &curv);
+        float sp = tcb_softplus((float)s, &sig);
+        float sig2 = tcb_sigmoid((float)s, &curv);
         double x = (float)s;
         double sp_ref = x > 20.0 ? x : log1p(exp(x));
         double sig_ref = x > 20.0 ? 1.0 : 1.0 / (1.0 + exp(-x));
@@ -285,8 +285,8 @@ static void test_softplus_accuracy(void **state)
         fail_msg("relative errors: softplus %.3g, sigma %.3g, curvature %.3g", worst_sp,
                  worst_sig, worst_curv);
     float sig;
-    assert_true(isnan(tcb_atlas_softplus(NAN, &sig)));
-    assert_true(tcb_atlas_softplus(-1000.0f, &sig) >= 0.0f && sig >= 0.0f && sig < 1e-30f);
+    assert_true(isnan(tcb_softplus(NAN, &sig)));
+    assert_true(tcb_softplus(-1000.0f, &sig) >= 0.0f && sig >= 0.0f && sig < 1e-30f);
 }
 
 int main(void)

@@ -12,7 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "methods/atlas/adam.h"
+#include "neural/adam.h"
 #include "methods/atlas/train.h"
 #include "tcb/fsutil.h"
 #include "tcb/metrics.h"
@@ -32,28 +32,28 @@
 static void test_adam_two_steps(void **state)
 {
     (void)state;
-    tcb_atlas_adam a;
+    tcb_adam a;
     tcb_error err = {0};
-    assert_int_equal(tcb_atlas_adam_init(&a, 2, &err), TCB_OK);
+    assert_int_equal(tcb_adam_init(&a, 2, &err), TCB_OK);
     float p[2] = {1, -2}, g1[2] = {0.5f, 0}, g2[2] = {-1, 3};
-    tcb_atlas_adam_step(&a, p, g1, 0.1);
+    tcb_adam_step(&a, p, g1, 0.1);
     assert_near(p[0], 0.9, 1e-6);
     assert_near(p[1], -2.0, 0);
-    tcb_atlas_adam_step(&a, p, g2, 0.1);
+    tcb_adam_step(&a, p, g2, 0.1);
     assert_near(p[0], 0.9366103542405653, 1e-6);
     assert_near(p[1], -2.0744136820059964, 1e-6);
-    tcb_atlas_adam_free(&a);
+    tcb_adam_free(&a);
 }
 
 static void test_lr_schedule(void **state)
 {
     (void)state;
-    assert_near(tcb_atlas_lr_at(1e-3, 0, 200000), 1e-3, 0);
-    assert_near(tcb_atlas_lr_at(1e-3, 159999, 200000), 1e-3, 0);
-    assert_near(tcb_atlas_lr_at(1e-3, 160000, 200000), 1e-4, 1e-18);
-    assert_near(tcb_atlas_lr_at(1e-3, 179999, 200000), 1e-4, 1e-18);
-    assert_near(tcb_atlas_lr_at(1e-3, 180000, 200000), 1e-5, 1e-18);
-    assert_near(tcb_atlas_lr_at(1e-3, 199999, 200000), 1e-5, 1e-18);
+    assert_near(tcb_lr_at(1e-3, 0, 200000), 1e-3, 0);
+    assert_near(tcb_lr_at(1e-3, 159999, 200000), 1e-3, 0);
+    assert_near(tcb_lr_at(1e-3, 160000, 200000), 1e-4, 1e-18);
+    assert_near(tcb_lr_at(1e-3, 179999, 200000), 1e-4, 1e-18);
+    assert_near(tcb_lr_at(1e-3, 180000, 200000), 1e-5, 1e-18);
+    assert_near(tcb_lr_at(1e-3, 199999, 200000), 1e-5, 1e-18);
 }
 
 /* ---- a short synthetic sequence ------------------------------------------ */

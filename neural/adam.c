@@ -1,28 +1,36 @@
-#include "methods/atlas/adam.h"
+#include "neural/adam.h"
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
-int tcb_atlas_adam_init(tcb_atlas_adam *a, size_t n, tcb_error *err)
+int tcb_adam_init(tcb_adam *a, size_t n, tcb_error *err)
 {
-    *a = (tcb_atlas_adam){.n = n, .b1 = 0.9, .b2 = 0.999, .eps = 1e-8};
+    *a = (tcb_adam){.n = n, .b1 = 0.9, .b2 = 0.999, .eps = 1e-8};
     a->m = calloc(n ? n : 1, sizeof *a->m);
     a->v = calloc(n ? n : 1, sizeof *a->v);
     if (!a->m || !a->v) {
-        tcb_atlas_adam_free(a);
-        return tcb_fail(err, TCB_ERR_NOMEM, "atlas: out of memory for Adam state (%zu params)", n);
+        tcb_adam_free(a);
+        return tcb_fail(err, TCB_ERR_NOMEM, "adam: out of memory for its state (%zu params)", n);
     }
     return TCB_OK;
 }
 
-void tcb_atlas_adam_free(tcb_atlas_adam *a)
+void tcb_adam_free(tcb_adam *a)
 {
     free(a->m);
     free(a->v);
     a->m = a->v = NULL;
 }
 
-void tcb_atlas_adam_step(tcb_atlas_adam *a, float *params, const float *grads, double lr)
+void tcb_adam_reset(tcb_adam *a)
+{
+    memset(a->m, 0, a->n * sizeof *a->m);
+    memset(a->v, 0, a->n * sizeof *a->v);
+    a->t = 0;
+}
+
+void tcb_adam_step(tcb_adam *a, float *params, const float *grads, double lr)
 {
     a->t++;
     /* The scalars in double as torch computes them in Python floats. */
@@ -42,7 +50,7 @@ void tcb_atlas_adam_step(tcb_atlas_adam *a, float *params, const float *grads, d
     }
 }
 
-double tcb_atlas_lr_at(double lr0, long long it, long long total)
+double tcb_lr_at(double lr0, long long it, long long total)
 {
     double lr = lr0;
     if (it >= total * 8 / 10) lr *= 0.1;

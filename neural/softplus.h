@@ -9,20 +9,20 @@
  * PyTorch's Softplus(beta=1, threshold=20): softplus(s) = s above 20, else
  * log1p(exp(s)); its backward uses σ(s) below the threshold and exactly 1
  * above, so softplus′′ = σ(1 − σ) below and 0 above. */
-#ifndef TCB_ATLAS_SOFTPLUS_H
-#define TCB_ATLAS_SOFTPLUS_H
+#ifndef TCB_SOFTPLUS_H
+#define TCB_SOFTPLUS_H
 
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
 
-#define TCB_ATLAS_SOFTPLUS_THRESHOLD 20.0f
+#define TCB_SOFTPLUS_THRESHOLD 20.0f
 
 /* c ? a : b on the bit patterns. Written as a float ?:, gcc splits the loop
  * body into paths (one of them with a constant to fold) and then, as float
  * arithmetic "may trap" under the default -ftrapping-math, refuses to merge
  * them back: the loop stays scalar. Integer masks keep it one path. */
-static inline float tcb_atlas_select(int c, float a, float b)
+static inline float tcb_select(int c, float a, float b)
 {
     uint32_t ab, bb, mask = (uint32_t)0 - (uint32_t)(c != 0);
     memcpy(&ab, &a, sizeof ab);
@@ -38,7 +38,7 @@ static inline float tcb_atlas_select(int c, float a, float b)
  * instead of going denormal; softplus and σ do not notice 1e-38. The clamp
  * compares bit patterns (monotonic in |x| for negative floats); a NaN is
  * clamped too, softplus keeps it through s. */
-static inline float tcb_atlas_exp_neg(float x)
+static inline float tcb_exp_neg(float x)
 {
     const float lo = -87.0f;
     uint32_t xb, lb;
@@ -69,7 +69,7 @@ static inline float tcb_atlas_exp_neg(float x)
 /* log1p(e) for e in [0, 1] as 2·atanh(t), t = e/(2 + e) ≤ 1/3: an odd series
  * in t, accurate in relative terms down to e → 0 (where log1p(e) ≈ e).
  * Terms to t^19: the first dropped, t^21/21 ≤ 4e-12 · t. */
-static inline float tcb_atlas_log1p_unit(float e)
+static inline float tcb_log1p_unit(float e)
 {
     float t = e / (2.0f + e), t2 = t * t;
     float p = 1.0f / 19.0f;
@@ -86,26 +86,26 @@ static inline float tcb_atlas_log1p_unit(float e)
 }
 
 /* softplus(s) = max(s, 0) + log1p(exp(−|s|)); *sig = σ(s). */
-static inline float tcb_atlas_softplus(float s, float *sig)
+static inline float tcb_softplus(float s, float *sig)
 {
-    float e = tcb_atlas_exp_neg(-fabsf(s));
+    float e = tcb_exp_neg(-fabsf(s));
     float inv = 1.0f / (1.0f + e), e_inv = e * inv;
-    float l = tcb_atlas_log1p_unit(e), s_l = s + l;
-    float sp = tcb_atlas_select(s < 0.0f, l, s_l); /* max(s, 0) + l; NaN stays NaN */
-    int above = s > TCB_ATLAS_SOFTPLUS_THRESHOLD;
-    *sig = tcb_atlas_select(above, 1.0f, tcb_atlas_select(s < 0.0f, e_inv, inv));
-    return tcb_atlas_select(above, s, sp);
+    float l = tcb_log1p_unit(e), s_l = s + l;
+    float sp = tcb_select(s < 0.0f, l, s_l); /* max(s, 0) + l; NaN stays NaN */
+    int above = s > TCB_SOFTPLUS_THRESHOLD;
+    *sig = tcb_select(above, 1.0f, tcb_select(s < 0.0f, e_inv, inv));
+    return tcb_select(above, s, sp);
 }
 
 /* σ(s) = softplus′(s); *curv = softplus′′(s) = σ(1 − σ) = e/(1 + e)² with
  * e = exp(−|s|), which keeps its relative precision where 1 − σ would not. */
-static inline float tcb_atlas_sigmoid(float s, float *curv)
+static inline float tcb_sigmoid(float s, float *curv)
 {
-    float e = tcb_atlas_exp_neg(-fabsf(s));
+    float e = tcb_exp_neg(-fabsf(s));
     float inv = 1.0f / (1.0f + e), e_inv = e * inv, c = e_inv * inv;
-    int above = s > TCB_ATLAS_SOFTPLUS_THRESHOLD;
-    *curv = tcb_atlas_select(above, 0.0f, c);
-    return tcb_atlas_select(above, 1.0f, tcb_atlas_select(s < 0.0f, e_inv, inv));
+    int above = s > TCB_SOFTPLUS_THRESHOLD;
+    *curv = tcb_select(above, 0.0f, c);
+    return tcb_select(above, 1.0f, tcb_select(s < 0.0f, e_inv, inv));
 }
 
 #endif

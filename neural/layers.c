@@ -1,4 +1,4 @@
-#include "methods/atlas/layers.h"
+#include "neural/layers.h"
 
 #include <cblas.h>
 #include <stddef.h>
@@ -17,7 +17,7 @@
 
 static int imin(int a, int b) { return a < b ? a : b; }
 
-void tcb_atlas_linear_bind(tcb_atlas_linear *l, float *base, size_t *offset, int in, int out)
+void tcb_linear_bind(tcb_linear *l, float *base, size_t *offset, int in, int out)
 {
     l->W = base + *offset;
     l->b = l->W + (size_t)in * out;
@@ -25,7 +25,7 @@ void tcb_atlas_linear_bind(tcb_atlas_linear *l, float *base, size_t *offset, int
     *offset += (size_t)in * out + out;
 }
 
-void tcb_atlas_colsum_acc(float *db, const float *dy, int n, int d)
+void tcb_colsum_acc(float *db, const float *dy, int n, int d)
 {
     int nchunks = (d + CHUNK - 1) / CHUNK;
 #pragma omp parallel for schedule(static) if ((double)n * d > PAR_MIN)
@@ -133,7 +133,7 @@ static void tiny_backward_weight(float *dW, const float *dy, const float *x, int
     }
 }
 
-void tcb_atlas_linear_forward(float *y, const float *x, const float *W, const float *b, int n,
+void tcb_linear_forward(float *y, const float *x, const float *W, const float *b, int n,
                               int nt, int in, int out)
 {
     int rows = (1 + nt) * n;
@@ -149,11 +149,11 @@ void tcb_atlas_linear_forward(float *y, const float *x, const float *W, const fl
                     1.0f, y, out);
 }
 
-void tcb_atlas_linear_backward(float *dx, float *dW, float *db, const float *dy, const float *x,
+void tcb_linear_backward(float *dx, float *dW, float *db, const float *dy, const float *x,
                                const float *W, int n, int nt, int in, int out)
 {
     int rows = (1 + nt) * n;
-    if (db) tcb_atlas_colsum_acc(db, dy, n, out);
+    if (db) tcb_colsum_acc(db, dy, n, out);
     if (in <= TINY || out <= TINY) {
         tiny_backward_weight(dW, dy, x, rows, in, out);
         if (dx) tiny_backward_input(dx, dy, W, rows, in, out);
@@ -166,13 +166,13 @@ void tcb_atlas_linear_backward(float *dx, float *dW, float *db, const float *dy,
                     in, 0.0f, dx, in);
 }
 
-void tcb_atlas_relu_forward(float *y, const float *x, int64_t n)
+void tcb_relu_forward(float *y, const float *x, int64_t n)
 {
 #pragma omp parallel for schedule(static) if ((double)n > PAR_MIN)
     for (int64_t i = 0; i < n; i++) y[i] = x[i] > 0.0f ? x[i] : 0.0f;
 }
 
-void tcb_atlas_relu_backward(float *dx, const float *dy, const float *y, int64_t n)
+void tcb_relu_backward(float *dx, const float *dy, const float *y, int64_t n)
 {
 #pragma omp parallel for schedule(static) if ((double)n > PAR_MIN)
     for (int64_t i = 0; i < n; i++) dx[i] = y[i] > 0.0f ? dy[i] : 0.0f;
@@ -180,7 +180,7 @@ void tcb_atlas_relu_backward(float *dx, const float *dy, const float *y, int64_t
 
 /* The elementwise loops run over CHUNK columns at a time so σ and σ′ of the
  * value rows can sit in small arrays while the tangent rows use them. */
-void tcb_atlas_softplus_forward(float *y, const float *x, int n, int nt, int d)
+void tcb_softplus_forward(float *y, const float *x, int n, int nt, int d)
 {
     size_t blk = (size_t)n * d;
 #pragma omp parallel for schedule(static) if ((double)n * d > PAR_MIN)
@@ -192,7 +192,7 @@ void tcb_atlas_softplus_forward(float *y, const float *x, int n, int nt, int d)
             const float *xs = x + at;
             float *ys = y + at;
 #pragma omp simd
-            for (int j = 0; j < w; j++) ys[j] = tcb_atlas_softplus(xs[j], &sig[j]);
+            for (int j = 0; j < w; j++) ys[j] = tcb_softplus(xs[j], &sig[j]);
             for (int t = 1; t <= nt; t++) {
                 const float *xt = x + t * blk + at;
                 float *yt = y + t * blk + at;
@@ -203,7 +203,7 @@ void tcb_atlas_softplus_forward(float *y, const float *x, int n, int nt, int d)
     }
 }
 
-void tcb_atlas_softplus_backward(float *dx, const float *dy, const float *x, int n, int nt,
+void tcb_softplus_backward(float *dx, const float *dy, const float *x, int n, int nt,
                                  int d)
 {
     size_t blk = (size_t)n * d;
@@ -216,7 +216,7 @@ void tcb_atlas_softplus_backward(float *dx, const float *dy, const float *x, int
             const float *xs = x + at, *dys = dy + at;
 #pragma omp simd
             for (int j = 0; j < w; j++) {
-                sig[j] = tcb_atlas_sigmoid(xs[j], &curv[j]);
+                sig[j] = tcb_sigmoid(xs[j], &curv[j]);
                 ds[j] = sig[j] * dys[j];
             }
             for (int t = 1; t <= nt; t++) {
@@ -234,7 +234,7 @@ void tcb_atlas_softplus_backward(float *dx, const float *dy, const float *x, int
     }
 }
 
-void tcb_atlas_maxpool_forward(float *y, int32_t *arg, const float *x, int nb, int n, int d)
+void tcb_maxpool_forward(float *y, int32_t *arg, const float *x, int nb, int n, int d)
 {
 #pragma omp parallel for schedule(static) if ((double)nb * n * d > PAR_MIN)
     for (int b = 0; b < nb; b++) {
@@ -250,11 +250,11 @@ void tcb_atlas_maxpool_forward(float *y, int32_t *arg, const float *x, int nb, i
     }
 }
 
-void tcb_atlas_maxpool_linear_backward(float *dx, float *dW, float *db, const float *dy,
+void tcb_maxpool_linear_backward(float *dx, float *dW, float *db, const float *dy,
                                        const int32_t *arg, const float *x, const float *W,
                                        int nb, int n, int in, int out)
 {
-    tcb_atlas_colsum_acc(db, dy, nb, out);
+    tcb_colsum_acc(db, dy, nb, out);
     /* dW: each channel's row owned by one thread, the sets summed in order */
 #pragma omp parallel for schedule(static) if ((double)nb * in * out > PAR_MIN)
     for (int o = 0; o < out; o++) {

@@ -1,5 +1,6 @@
-/* The atlas networks' layers: each a forward/backward pair over caller-owned
- * float32 buffers (llm.c style), row-major, one row per point or sample.
+/* Neural-network layers shared by the trained methods (the atlas family,
+ * cc): each a forward/backward pair over caller-owned float32 buffers
+ * (llm.c style), row-major, one row per point or sample.
  *
  * Forward-mode tangents ride along as extra rows. A "stacked" buffer of n
  * value rows with nt tangent blocks is [(1 + nt)·n][d]: rows [0, n) hold the
@@ -14,55 +15,55 @@
  * OpenMP over rows, and every reduction over rows is split by columns with a
  * fixed summation order, so results do not depend on the thread count except
  * through OpenBLAS's own blocking. */
-#ifndef TCB_ATLAS_LAYERS_H
-#define TCB_ATLAS_LAYERS_H
+#ifndef TCB_NEURAL_LAYERS_H
+#define TCB_NEURAL_LAYERS_H
 
 #include <stddef.h>
 #include <stdint.h>
 
-#include "methods/atlas/softplus.h"
+#include "neural/softplus.h"
 
 /* A linear layer's tensors, viewed inside a flat buffer (parameters or their
  * gradients): W [out][in] then b [out], PyTorch's layout. */
-typedef struct tcb_atlas_linear {
+typedef struct tcb_linear {
     float *W, *b;
     int in, out;
-} tcb_atlas_linear;
+} tcb_linear;
 
 /* Views l at base + *offset and advances *offset by its in·out + out floats. */
-void tcb_atlas_linear_bind(tcb_atlas_linear *l, float *base, size_t *offset, int in, int out);
+void tcb_linear_bind(tcb_linear *l, float *base, size_t *offset, int in, int out);
 
 /* y[(1+nt)·n][out] = x[(1+nt)·n][in] · W[out][in]ᵀ, plus b[out] on the n value
  * rows (PyTorch's Linear layout; b may be NULL). Tiny dimensions (in or out
  * ≤ 3: the xyz input, the xyz output) use fused loops, the rest cblas_sgemm. */
-void tcb_atlas_linear_forward(float *y, const float *x, const float *W, const float *b, int n,
+void tcb_linear_forward(float *y, const float *x, const float *W, const float *b, int n,
                               int nt, int in, int out);
 
 /* dW[out][in] += dyᵀ·x over all (1+nt)·n rows; db[out] += Σ dy over the n value
  * rows (db may be NULL iff b was); dx[(1+nt)·n][in] = dy·W (dx may be NULL). */
-void tcb_atlas_linear_backward(float *dx, float *dW, float *db, const float *dy, const float *x,
+void tcb_linear_backward(float *dx, float *dW, float *db, const float *dy, const float *x,
                                const float *W, int n, int nt, int in, int out);
 
 /* y[n] = max(x, 0); y may alias x. */
-void tcb_atlas_relu_forward(float *y, const float *x, int64_t n);
+void tcb_relu_forward(float *y, const float *x, int64_t n);
 
 /* dx[n] = dy · [y > 0] from the forward output y; dx may alias dy. */
-void tcb_atlas_relu_backward(float *dx, const float *dy, const float *y, int64_t n);
+void tcb_relu_backward(float *dx, const float *dy, const float *y, int64_t n);
 
 /* Stacked softplus: x = [s; t_1..t_nt] (pre-activations and their tangents,
  * [(1+nt)·n][d]) → y = [softplus(s); σ(s)⊙t_1; …; σ(s)⊙t_nt]. */
-void tcb_atlas_softplus_forward(float *y, const float *x, int n, int nt, int d);
+void tcb_softplus_forward(float *y, const float *x, int n, int nt, int d);
 
 /* Exact reverse mode through values and tangents, the product rule on
  * t_a = σ(s)·t_s:
  *     ds   = σ·da + σ(1−σ)·Σ_j t_j·dt_aj,      dt_sj = σ·dt_aj.
  * dx, dy, x: [(1+nt)·n][d]; dx may alias dy. */
-void tcb_atlas_softplus_backward(float *dx, const float *dy, const float *x, int n, int nt,
+void tcb_softplus_backward(float *dx, const float *dy, const float *x, int n, int nt,
                                  int d);
 
 /* Max over the n points of each of nb sets: x [nb][n][d] → y [nb][d], with
  * arg [nb][d] the winning point (the first one on ties, as torch.max). */
-void tcb_atlas_maxpool_forward(float *y, int32_t *arg, const float *x, int nb, int n, int d);
+void tcb_maxpool_forward(float *y, int32_t *arg, const float *x, int nb, int n, int d);
 
 /* Backward of y = maxpool(x·Wᵀ + b) over the n points of each of nb sets
  * (x [nb][n][in], W [out][in], y [nb][out]), given dy and the forward's arg.
@@ -70,11 +71,11 @@ void tcb_atlas_maxpool_forward(float *y, int32_t *arg, const float *x, int nb, i
  * the dense [nb·n][out] gradient and two GEMMs over it, only those rows are
  * touched: dW[o] += Σ_b dy[b][o]·x[b][arg[b][o]], db += Σ_b dy[b], and
  * dx [nb][n][in] = dy routed through W (zero at points that won nothing). */
-void tcb_atlas_maxpool_linear_backward(float *dx, float *dW, float *db, const float *dy,
+void tcb_maxpool_linear_backward(float *dx, float *dW, float *db, const float *dy,
                                        const int32_t *arg, const float *x, const float *W,
                                        int nb, int n, int in, int out);
 
 /* db[d] += Σ_{r<n} dy[r][d], summed in double per column. */
-void tcb_atlas_colsum_acc(float *db, const float *dy, int n, int d);
+void tcb_colsum_acc(float *db, const float *dy, int n, int d);
 
 #endif
