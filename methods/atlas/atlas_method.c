@@ -243,43 +243,19 @@ static void destroy(void *self)
 }
 
 /* ---- checkpoint -----------------------------------------------------------
- * One file (the harness publishes a single path), host byte order:
- *     char   magic[8]   "TCBATLS1"
- *     uint64 seed       of the fit (the evaluation's UV sets derive from it)
- *     uint64 mlen       then the model manifest (model.h), mlen bytes
- *     float  params[]   the rest: the model's export
- * The model's own export/import writes and checks the two parts, so they go
- * through side files next to the checkpoint. */
+ * One model file (neural/weights.h) under the magic "TCBATLS1": the fit's
+ * seed (the evaluation's UV sets derive from it), the model's manifest and
+ * its weights. */
 #define MAGIC "TCBATLS1"
-#define HDR 24
-
-static int side_paths(const char *path, char *bin, char *man, tcb_error *err)
-{
-    int rc = tcb_path_join(bin, TCB_PATH_MAX, err, "%s.weights", path);
-    if (!rc) rc = tcb_path_join(man, TCB_PATH_MAX, err, "%s.manifest.json", path);
-    return rc;
-}
 
 static int save(void *self, const char *path, tcb_error *err)
 {
     atlas_method *a = self;
     if (!a->model) return tcb_fail(err, TCB_ERR_INTERNAL, "%s: %s saved before fit", path, a->name);
-    char bin[TCB_PATH_MAX], man[TCB_PATH_MAX];
-    char *wb = NULL, *mb = NULL, *buf = NULL;
-    size_t wl = 0, ml = 0;
-    int rc = side_paths(path, bin, man, err);
-    if (!rc) rc = tcb_atlas_model_export(a->model, bin, man, err);
-    if (!rc) rc = tcb_read_file(bin, &wb, &wl, err);
-    if (!rc) rc = tcb_read_file(man, &mb, &ml, err);
-    if (!rc && !(buf = malloc(HDR + ml + wl))) rc = tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", path);
-    if (!rc) {
-        uint64_t mlen = ml;
-        memcpy(buf, MAGIC, 8), memcpy(buf + 8, &a->seed, 8), memcpy(buf + 16, &mlen, 8);
-        memcpy(buf + HDR, mb, ml), memcpy(buf + HDR + ml, wb, wl);
-        rc = tcb_write_file_atomic(path, buf, HDR + ml + wl, err);
-    }
-    remove(bin), remove(man);
-    free(wb), free(mb), free(buf);
+    cJSON *manifest = tcb_atlas_model_manifest(a->model);
+    tcb_weight_parts w = tcb_atlas_model_weights(a->model);
+    int rc = tcb_model_file_write(path, MAGIC, a->seed, manifest, &w, err);
+    cJSON_Delete(manifest);
     return rc;
 }
 
@@ -287,21 +263,22 @@ static int load(void *self, const tcb_sequence *seq, const char *path, tcb_error
 {
     (void)seq; /* the weights do not depend on which sequence is evaluated */
     atlas_method *a = self;
-    char bin[TCB_PATH_MAX], man[TCB_PATH_MAX], *buf = NULL;
-    size_t len = 0;
-    uint64_t seed = 0, mlen = 0;
-    int rc = side_paths(path, bin, man, err);
-    if (!rc) rc = tcb_read_file(path, &buf, &len, err);
-    if (!rc && len >= HDR) memcpy(&seed, buf + 8, 8), memcpy(&mlen, buf + 16, 8);
-    if (!rc && (len < HDR || memcmp(buf, MAGIC, 8) || mlen > len - HDR))
-        rc = tcb_fail(err, TCB_ERR_INPUT, "%s: not an atlas checkpoint (bad magic or length)", path);
-    if (!rc) rc = tcb_write_file_atomic(man, buf + HDR, mlen, err);
-    if (!rc) rc = tcb_write_file_atomic(bin, buf + HDR + mlen, len - HDR - mlen, err);
-    if (!rc) rc = new_model(a, seed, err);
-    if (!rc) rc = tcb_atlas_model_import(a->model, bin, man, err);
-    if (rc && a->model) tcb_atlas_model_free(a->model), a->model = NULL;
-    remove(bin), remove(man);
-    free(buf);
+    uint64_t seed = 0;
+    int rc = new_model(a, 0, err);
+    if (rc) return rc;
+    cJSON *want = tcb_atlas_model_manifest(a->model);
+    tcb_weight_parts w = tcb_atlas_model_weights(a->model);
+    rc = tcb_model_file_read(path, MAGIC, want, &seed, &w, err);
+    cJSON_Delete(want);
+    if (!rc) {
+        /* the UV cache belongs to the fit's seed */
+        tcb_atlas_uv_cache_free(&a->uvc);
+        tcb_atlas_uv_cache_init(&a->uvc, seed);
+        a->seed = seed;
+    } else {
+        tcb_atlas_model_free(a->model);
+        a->model = NULL;
+    }
     return rc;
 }
 

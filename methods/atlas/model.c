@@ -7,7 +7,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "tcb/fsutil.h"
 #include "tcb/json.h"
 
 #define MANIFEST_FORMAT "tcbench-atlas-weights"
@@ -245,7 +244,7 @@ int tcb_atlas_model_backward(tcb_atlas_model *m, tcb_atlas_work *w, const float 
 
 /* ---- export / import ---- */
 
-static cJSON *manifest_build(const tcb_atlas_model *m)
+cJSON *tcb_atlas_model_manifest(const tcb_atlas_model *m)
 {
     cJSON *root = cJSON_CreateObject(), *tensors = cJSON_CreateArray();
     cJSON_AddStringToObject(root, "format", MANIFEST_FORMAT);
@@ -259,73 +258,31 @@ static cJSON *manifest_build(const tcb_atlas_model *m)
         char prefix[NAME_LEN], name[NAME_LEN + 8];
         int in, out;
         layer_info(m->C, k, prefix, &in, &out);
-        for (int bias = 0; bias < 2; bias++) {
-            cJSON *t = cJSON_CreateObject(), *shape = cJSON_CreateArray();
-            size_t count = bias ? (size_t)out : (size_t)in * out;
-            snprintf(name, sizeof name, "%s.%s", prefix, bias ? "bias" : "weight");
-            cJSON_AddStringToObject(t, "name", name);
-            cJSON_AddItemToArray(shape, cJSON_CreateNumber(out));
-            if (!bias) cJSON_AddItemToArray(shape, cJSON_CreateNumber(in));
-            cJSON_AddItemToObject(t, "shape", shape);
-            cJSON_AddNumberToObject(t, "offset", (double)off);
-            cJSON_AddNumberToObject(t, "count", (double)count);
-            cJSON_AddItemToArray(tensors, t);
-            off += count;
-        }
+        int shape[2] = {out, in};
+        snprintf(name, sizeof name, "%s.weight", prefix);
+        tcb_manifest_add_tensor(tensors, name, shape, 2, off);
+        off += (size_t)in * out;
+        snprintf(name, sizeof name, "%s.bias", prefix);
+        tcb_manifest_add_tensor(tensors, name, shape, 1, off);
+        off += (size_t)out;
     }
     return root;
+}
+
+tcb_weight_parts tcb_atlas_model_weights(const tcb_atlas_model *m)
+{
+    return (tcb_weight_parts){.n = 1, .data = {m->params}, .count = {m->nparams}};
 }
 
 int tcb_atlas_model_export(const tcb_atlas_model *m, const char *bin_path,
                            const char *manifest_path, tcb_error *err)
 {
-    tcb_atomic_file af;
-    int rc = tcb_atomic_open(&af, bin_path, err);
+    tcb_weight_parts w = tcb_atlas_model_weights(m);
+    int rc = tcb_weights_write(bin_path, &w, err);
     if (rc) return rc;
-    unsigned char buf[4096 * 4];
-    for (size_t i = 0; i < m->nparams;) {
-        size_t n = 0;
-        for (; n < 4096 && i < m->nparams; n++, i++) {
-            uint32_t u;
-            memcpy(&u, &m->params[i], 4);
-            for (int k = 0; k < 4; k++) buf[4 * n + k] = (unsigned char)(u >> (8 * k));
-        }
-        if (fwrite(buf, 4, n, af.fp) != n) {
-            tcb_atomic_abort(&af);
-            return tcb_fail(err, TCB_ERR_IO, "%s: write failed", bin_path);
-        }
-    }
-    if ((rc = tcb_atomic_commit(&af, err))) return rc;
-    cJSON *manifest = manifest_build(m);
+    cJSON *manifest = tcb_atlas_model_manifest(m);
     rc = tcb_json_save(manifest_path, manifest, err);
     cJSON_Delete(manifest);
-    return rc;
-}
-
-/* The manifest must equal the one this model would write, item by item. */
-static int manifest_check(const cJSON *got, const cJSON *want, const char *where,
-                          tcb_error *err)
-{
-    if (cJSON_Compare(got, want, 1)) return TCB_OK;
-    if (cJSON_IsObject(want) || cJSON_IsArray(want)) {
-        if (cJSON_GetArraySize(got) != cJSON_GetArraySize(want) ||
-            cJSON_IsObject(got) != cJSON_IsObject(want) || cJSON_IsArray(got) != cJSON_IsArray(want))
-            return tcb_fail(err, TCB_ERR_INPUT, "%s: does not match this model's layout", where);
-        int i = 0;
-        for (const cJSON *w = want->child; w; w = w->next, i++) {
-            char sub[TCB_ERRMSG_MAX / 2];
-            const cJSON *g = cJSON_IsObject(want) ? cJSON_GetObjectItemCaseSensitive(got, w->string)
-                                                  : cJSON_GetArrayItem(got, i);
-            if (cJSON_IsObject(want)) snprintf(sub, sizeof sub, "%s.%s", where, w->string);
-            else snprintf(sub, sizeof sub, "%s[%d]", where, i);
-            int rc = manifest_check(g, w, sub, err);
-            if (rc) return rc;
-        }
-    }
-    char *text = cJSON_PrintUnformatted(want);
-    int rc = tcb_fail(err, TCB_ERR_INPUT, "%s: expected %s for this model", where,
-                      text ? text : "another value");
-    free(text);
     return rc;
 }
 
@@ -335,24 +292,10 @@ int tcb_atlas_model_import(tcb_atlas_model *m, const char *bin_path, const char 
     cJSON *got;
     int rc = tcb_json_load(manifest_path, &got, err);
     if (rc) return rc;
-    cJSON *want = manifest_build(m);
-    rc = manifest_check(got, want, manifest_path, err);
+    cJSON *want = tcb_atlas_model_manifest(m);
+    rc = tcb_manifest_check(got, want, manifest_path, err);
     cJSON_Delete(got), cJSON_Delete(want);
     if (rc) return rc;
-    char *data;
-    size_t len;
-    if ((rc = tcb_read_file(bin_path, &data, &len, err))) return rc;
-    if (len != m->nparams * 4) {
-        free(data);
-        return tcb_fail(err, TCB_ERR_INPUT, "%s: %zu bytes, expected %zu (%zu float32)", bin_path,
-                        len, m->nparams * 4, m->nparams);
-    }
-    const unsigned char *p = (const unsigned char *)data;
-    for (size_t i = 0; i < m->nparams; i++, p += 4) {
-        uint32_t u = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 |
-                     (uint32_t)p[3] << 24;
-        memcpy(&m->params[i], &u, 4);
-    }
-    free(data);
-    return TCB_OK;
+    tcb_weight_parts w = tcb_atlas_model_weights(m);
+    return tcb_weights_read(bin_path, &w, err);
 }

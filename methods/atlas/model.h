@@ -13,6 +13,7 @@
 
 #include "methods/atlas/decoder.h"
 #include "methods/atlas/encoder.h"
+#include "neural/weights.h"
 #include "tcb/error.h"
 #include "tcb/rng.h"
 
@@ -90,6 +91,11 @@ int tcb_atlas_model_backward(tcb_atlas_model *m, tcb_atlas_work *w, const float 
  * weights written as [out, in]. Both files are written atomically. */
 int tcb_atlas_model_export(const tcb_atlas_model *m, const char *bin_path,
                            const char *manifest_path, tcb_error *err);
+
+/* The manifest export writes (the caller deletes it) and the weights as
+ * parts (one: the flat parameter vector), for neural/weights.h. */
+cJSON *tcb_atlas_model_manifest(const tcb_atlas_model *m);
+tcb_weight_parts tcb_atlas_model_weights(const tcb_atlas_model *m);
 
 /* Reads weights written by export into a model of the same C and P; any
  * mismatch of the manifest (format, dims, a tensor's name, shape or offset)
