@@ -7,11 +7,10 @@
  *   tiny   C 32,   P 4,  M 200,      300 iterations (tests)
  *
  * Two kinds of checkpoint. During fit, every `checkpoint_every` iterations
- * the whole training state goes to <work_dir>/train.ckpt (train_ckpt.h); a
- * fit that finds one continues from it, bit-identical to an uninterrupted
- * training, and deletes it when done. After fit the harness saves the
+ * the whole training state goes to <work_dir>/train.ckpt (train_ckpt.h,
+ * through neural/train_loop.h); a fit that finds one continues from it,
+ * bit-identical to an uninterrupted training, and deletes it when done. After fit the harness saves the
  * trained weights through save/load below. */
-#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,7 +20,7 @@
 #include "methods/atlas/train_ckpt.h"
 #include "methods/builtin.h"
 #include "methods/params.h"
-#include "tcb/fsutil.h"
+#include "neural/train_loop.h"
 #include "tcb/json.h"
 #include "tcb/metrics.h"
 
@@ -124,63 +123,50 @@ static int new_model(atlas_method *a, uint64_t seed, tcb_error *err)
     return TCB_OK;
 }
 
-/* Continues from <work_dir>/train.ckpt when there is one; *earlier_s gets
- * the seconds that checkpoint cost (0 when training starts afresh). A
- * checkpoint that cannot be continued (corrupt, other settings) is reported
- * and ignored: training starts over, as the harness does with a bad model
- * checkpoint. */
-static void resume(atlas_method *a, tcb_atlas_trainer *t, const tcb_sequence *seq, const tcb_fit_ctx *ctx,
-                   const char *path, double *earlier_s)
+/* The training loop's view of an atlas training (neural/train_loop.h). */
+typedef struct atlas_fit {
+    tcb_atlas_trainer *t;
+    const tcb_sequence *seq;
+    uint64_t seed;
+} atlas_fit;
+
+static int fit_step(void *f, double *loss, tcb_error *err)
 {
-    *earlier_s = 0;
-    if (!path[0] || !tcb_is_file(path)) return;
-    tcb_error e = {0};
-    if (tcb_atlas_train_ckpt_load(t, seq, ctx->seed, path, earlier_s, &e) == TCB_OK)
-        tcb_report_log(&ctx->reporter, TCB_LOG_INFO, "%s: resuming training at iteration %lld from %s (%.0f s in)",
-                       a->name, t->it, path, *earlier_s);
-    else
-        tcb_report_log(&ctx->reporter, TCB_LOG_WARN, "%s: not resumed (%s); training from the start", a->name,
-                       e.msg);
+    atlas_fit *a = f;
+    return tcb_atlas_train_step(a->t, a->seq, loss, err);
 }
 
-static int train(atlas_method *a, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_error *err)
+static long long fit_done(const void *f) { return ((const atlas_fit *)f)->t->it; }
+
+static int fit_save(const void *f, double seconds, const char *path, tcb_error *err)
 {
-    double start = tcb_now_seconds(), earlier = 0;
-    tcb_atlas_trainer *t = NULL;
-    char ckpt[TCB_PATH_MAX] = "";
-    int rc = new_model(a, ctx->seed, err);
-    if (!rc && ctx->work_dir && a->checkpoint_every > 0)
-        rc = tcb_path_join(ckpt, sizeof ckpt, err, "%s/%s", ctx->work_dir, TCB_ATLAS_TRAIN_CKPT);
-    if (!rc) rc = tcb_atlas_trainer_create(&a->cfg, a->model, seq, ctx->seed, &t, err);
-    if (!rc) resume(a, t, seq, ctx, ckpt, &earlier);
-    long long total = a->cfg.iterations;
-    while (!rc && t->it < total) {
-        double loss;
-        rc = tcb_atlas_train_step(t, seq, &loss, err);
-        long long done = t->it;
-        if (!rc && (done % 10 == 0 || done == total))
-            tcb_report_progress(&ctx->reporter, (double)done, (double)total, a->name);
-        if (!rc && (done % 1000 == 0 || done == total))
-            tcb_report_log(&ctx->reporter, TCB_LOG_DEBUG, "%s: iteration %lld loss %.6g", a->name, done, loss);
-        if (!rc && ckpt[0] && done % a->checkpoint_every == 0 && done < total)
-            rc = tcb_atlas_train_ckpt_save(t, seq, ctx->seed, earlier + tcb_now_seconds() - start, ckpt, err);
-    }
-    if (ctx->resumed_fit_s) *ctx->resumed_fit_s = earlier;
-    tcb_atlas_trainer_free(t);
-    if (!rc && ckpt[0]) remove(ckpt); /* the harness's model checkpoint supersedes it */
-    if (rc) tcb_error_prefix(err, "%s: ", a->name);
-    return rc;
+    const atlas_fit *a = f;
+    return tcb_atlas_train_ckpt_save(a->t, a->seq, a->seed, seconds, path, err);
 }
 
-/* Training uses ctx->n_threads OpenMP threads (OpenBLAS's OpenMP build
- * follows them); the caller's setting is restored afterwards. The
- * evaluation runs with the process's setting, as it gets no ctx. */
+static int fit_load(void *f, const char *path, double *seconds, tcb_error *err)
+{
+    atlas_fit *a = f;
+    return tcb_atlas_train_ckpt_load(a->t, a->seq, a->seed, path, seconds, err);
+}
+
+/* Trains with ctx->n_threads OpenMP threads; the evaluation runs with the
+ * process's setting, as it gets no ctx. */
 static int fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_error *err)
 {
-    int prev_threads = omp_get_max_threads();
-    if (ctx->n_threads > 0) omp_set_num_threads(ctx->n_threads);
-    int rc = train(self, seq, ctx, err);
-    omp_set_num_threads(prev_threads);
+    atlas_method *a = self;
+    atlas_fit f = {.seq = seq, .seed = ctx->seed};
+    int rc = new_model(a, ctx->seed, err);
+    if (!rc) rc = tcb_atlas_trainer_create(&a->cfg, a->model, seq, ctx->seed, &f.t, err);
+    if (rc) {
+        tcb_error_prefix(err, "%s: ", a->name);
+        return rc;
+    }
+    tcb_train_loop loop = {.name = a->name, .iterations = a->cfg.iterations, .checkpoint_every = a->checkpoint_every,
+                           .ckpt_name = TCB_ATLAS_TRAIN_CKPT, .trainer = &f, .step = fit_step, .done = fit_done,
+                           .save = fit_save, .load = fit_load};
+    rc = tcb_train_loop_run(&loop, ctx, err);
+    tcb_atlas_trainer_free(f.t);
     return rc;
 }
 

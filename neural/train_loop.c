@@ -1,0 +1,56 @@
+#include "neural/train_loop.h"
+
+#include <omp.h>
+#include <stdio.h>
+
+#include "tcb/fsutil.h"
+
+/* Continues from path when there is a checkpoint there; *earlier_s gets
+ * the seconds it cost (0 when training starts afresh). */
+static void resume(const tcb_train_loop *loop, const tcb_fit_ctx *ctx, const char *path, double *earlier_s)
+{
+    *earlier_s = 0;
+    if (!path[0] || !tcb_is_file(path)) return;
+    tcb_error e = {0};
+    if (loop->load(loop->trainer, path, earlier_s, &e) == TCB_OK)
+        tcb_report_log(&ctx->reporter, TCB_LOG_INFO, "%s: resuming training at iteration %lld from %s (%.0f s in)",
+                       loop->name, loop->done(loop->trainer), path, *earlier_s);
+    else
+        tcb_report_log(&ctx->reporter, TCB_LOG_WARN, "%s: not resumed (%s); training from the start", loop->name,
+                       e.msg);
+}
+
+static int run(const tcb_train_loop *loop, const tcb_fit_ctx *ctx, tcb_error *err)
+{
+    double start = tcb_now_seconds(), earlier = 0;
+    char ckpt[TCB_PATH_MAX] = "";
+    int rc = TCB_OK;
+    if (ctx->work_dir && loop->checkpoint_every > 0)
+        rc = tcb_path_join(ckpt, sizeof ckpt, err, "%s/%s", ctx->work_dir, loop->ckpt_name);
+    if (!rc) resume(loop, ctx, ckpt, &earlier);
+    long long total = loop->iterations;
+    while (!rc && loop->done(loop->trainer) < total) {
+        double loss;
+        rc = loop->step(loop->trainer, &loss, err);
+        long long done = loop->done(loop->trainer);
+        if (!rc && (done % 10 == 0 || done == total))
+            tcb_report_progress(&ctx->reporter, (double)done, (double)total, loop->name);
+        if (!rc && (done % 1000 == 0 || done == total))
+            tcb_report_log(&ctx->reporter, TCB_LOG_DEBUG, "%s: iteration %lld loss %.6g", loop->name, done, loss);
+        if (!rc && ckpt[0] && done % loop->checkpoint_every == 0 && done < total)
+            rc = loop->save(loop->trainer, earlier + tcb_now_seconds() - start, ckpt, err);
+    }
+    if (ctx->resumed_fit_s) *ctx->resumed_fit_s = earlier;
+    if (!rc && ckpt[0]) remove(ckpt);
+    return rc;
+}
+
+int tcb_train_loop_run(const tcb_train_loop *loop, const tcb_fit_ctx *ctx, tcb_error *err)
+{
+    int prev_threads = omp_get_max_threads();
+    if (ctx->n_threads > 0) omp_set_num_threads(ctx->n_threads);
+    int rc = run(loop, ctx, err);
+    omp_set_num_threads(prev_threads);
+    if (rc) tcb_error_prefix(err, "%s: ", loop->name);
+    return rc;
+}

@@ -1,0 +1,36 @@
+/* The fit loop every trained method runs (the atlas family, cc): resume
+ * from the cell's training checkpoint when there is one, step to the last
+ * iteration with a progress bar and a debug line every 1 000 iterations,
+ * save the training state every `checkpoint_every` iterations, and delete
+ * it at the end (the harness's model checkpoint supersedes it). A
+ * checkpoint that cannot be continued (corrupt, other settings) is reported
+ * and ignored: training starts over, as the harness does with a bad model
+ * checkpoint. The method supplies the trainer behind four callbacks. */
+#ifndef TCB_NEURAL_TRAIN_LOOP_H
+#define TCB_NEURAL_TRAIN_LOOP_H
+
+#include "tcb/method.h"
+
+typedef struct tcb_train_loop {
+    const char *name;           /* the method's, for messages and the bar */
+    long long iterations;       /* the last iteration */
+    long long checkpoint_every; /* 0: no training checkpoints */
+    const char *ckpt_name;      /* the file's name inside ctx->work_dir */
+    void *trainer;
+    /* One iteration; *loss its loss. */
+    int (*step)(void *trainer, double *loss, tcb_error *err);
+    /* Iterations done. */
+    long long (*done)(const void *trainer);
+    /* Writes / restores the whole training state; `seconds` is the training
+     * time it has cost, over every process. */
+    int (*save)(const void *trainer, double seconds, const char *path, tcb_error *err);
+    int (*load)(void *trainer, const char *path, double *seconds, tcb_error *err);
+} tcb_train_loop;
+
+/* Runs the loop with ctx->n_threads OpenMP threads (OpenBLAS's OpenMP
+ * build follows them; the caller's setting is restored afterwards) and sets
+ * *ctx->resumed_fit_s to the seconds a resumed checkpoint had cost. Errors
+ * are prefixed with the method's name. */
+int tcb_train_loop_run(const tcb_train_loop *loop, const tcb_fit_ctx *ctx, tcb_error *err);
+
+#endif
