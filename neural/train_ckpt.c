@@ -135,3 +135,25 @@ int tcb_train_ckpt_read(const char *path, const char magic[8], const char *what,
     free(buf);
     return rc;
 }
+
+int tcb_trainer_state_save(const char *path, const char magic[8], const tcb_ckpt_settings *s,
+                           const tcb_trainer_state *st, double seconds, const tcb_ckpt_array *arrays,
+                           int n_arrays, tcb_error *err)
+{
+    tcb_train_progress p = {.it = *st->it, .adam_t = st->adam->t, .loss0 = *st->loss0, .seconds = seconds};
+    memcpy(p.rng, st->rng->s, sizeof p.rng);
+    return tcb_train_ckpt_write(path, magic, s, &p, arrays, n_arrays, err);
+}
+
+int tcb_trainer_state_load(const char *path, const char magic[8], const char *what,
+                           const tcb_ckpt_settings *want, int64_t max_it, const tcb_trainer_state *st,
+                           double *seconds, const tcb_ckpt_array *arrays, int n_arrays, tcb_error *err)
+{
+    tcb_train_progress p;
+    int rc = tcb_train_ckpt_read(path, magic, what, want, max_it, &p, arrays, n_arrays, err);
+    if (rc) return rc;
+    memcpy(st->rng->s, p.rng, sizeof p.rng);
+    *st->it = p.it, st->adam->t = p.adam_t, *st->loss0 = p.loss0;
+    *seconds = p.seconds;
+    return TCB_OK;
+}

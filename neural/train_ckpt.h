@@ -25,7 +25,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "neural/adam.h"
 #include "tcb/error.h"
+#include "tcb/rng.h"
 
 /* Where a training is. */
 typedef struct tcb_train_progress {
@@ -67,5 +69,25 @@ int tcb_train_ckpt_write(const char *path, const char magic[8], const tcb_ckpt_s
 int tcb_train_ckpt_read(const char *path, const char magic[8], const char *what,
                         const tcb_ckpt_settings *want, int64_t max_it, tcb_train_progress *p,
                         const tcb_ckpt_array *arrays, int n_arrays, tcb_error *err);
+
+/* A trainer's progress where it keeps it, so that one call saves or
+ * restores it: the iteration, the random stream, Adam (its step count; the
+ * moments go in as arrays) and the first loss. */
+typedef struct tcb_trainer_state {
+    long long *it;
+    tcb_rng *rng;
+    tcb_adam *adam;
+    double *loss0;
+} tcb_trainer_state;
+
+/* tcb_train_ckpt_write of st's progress with `seconds` of training. */
+int tcb_trainer_state_save(const char *path, const char magic[8], const tcb_ckpt_settings *s,
+                           const tcb_trainer_state *st, double seconds, const tcb_ckpt_array *arrays,
+                           int n_arrays, tcb_error *err);
+
+/* tcb_train_ckpt_read into st (all or nothing), *seconds its time stamp. */
+int tcb_trainer_state_load(const char *path, const char magic[8], const char *what,
+                           const tcb_ckpt_settings *want, int64_t max_it, const tcb_trainer_state *st,
+                           double *seconds, const tcb_ckpt_array *arrays, int n_arrays, tcb_error *err);
 
 #endif

@@ -113,6 +113,24 @@ int tcb_manifest_check(const cJSON *got, const cJSON *want, const char *where, t
     return rc;
 }
 
+int tcb_weights_export(const char *bin_path, const char *manifest_path, const cJSON *manifest,
+                       const tcb_weight_parts *w, tcb_error *err)
+{
+    int rc = tcb_weights_write(bin_path, w, err);
+    return rc ? rc : tcb_json_save(manifest_path, manifest, err);
+}
+
+int tcb_weights_import(const char *bin_path, const char *manifest_path, const cJSON *want,
+                       const tcb_weight_parts *w, tcb_error *err)
+{
+    cJSON *got;
+    int rc = tcb_json_load(manifest_path, &got, err);
+    if (rc) return rc;
+    rc = tcb_manifest_check(got, want, manifest_path, err);
+    cJSON_Delete(got);
+    return rc ? rc : tcb_weights_read(bin_path, w, err);
+}
+
 #define HDR 24
 
 int tcb_model_file_write(const char *path, const char magic[8], uint64_t seed, const cJSON *manifest,

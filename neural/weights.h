@@ -44,6 +44,15 @@ void tcb_manifest_add_tensor(cJSON *tensors, const char *name, const int *shape,
  * the first key that differs, with the value this model expects. */
 int tcb_manifest_check(const cJSON *got, const cJSON *want, const char *where, tcb_error *err);
 
+/* The two-file form the PyTorch cross-checks read: the weights at bin_path,
+ * the manifest as JSON at manifest_path, each written atomically. */
+int tcb_weights_export(const char *bin_path, const char *manifest_path, const cJSON *manifest,
+                       const tcb_weight_parts *w, tcb_error *err);
+
+/* Reads that form into the parts; the manifest must equal `want`. */
+int tcb_weights_import(const char *bin_path, const char *manifest_path, const cJSON *want,
+                       const tcb_weight_parts *w, tcb_error *err);
+
 /* The one-file model checkpoint: manifest and weights under a magic and the
  * fit's seed, written atomically. */
 int tcb_model_file_write(const char *path, const char magic[8], uint64_t seed, const cJSON *manifest,

@@ -274,28 +274,20 @@ tcb_weight_parts tcb_atlas_model_weights(const tcb_atlas_model *m)
     return (tcb_weight_parts){.n = 1, .data = {m->params}, .count = {m->nparams}};
 }
 
-int tcb_atlas_model_export(const tcb_atlas_model *m, const char *bin_path,
-                           const char *manifest_path, tcb_error *err)
+int tcb_atlas_model_export(const tcb_atlas_model *m, const char *bin_path, const char *manifest_path, tcb_error *err)
 {
-    tcb_weight_parts w = tcb_atlas_model_weights(m);
-    int rc = tcb_weights_write(bin_path, &w, err);
-    if (rc) return rc;
     cJSON *manifest = tcb_atlas_model_manifest(m);
-    rc = tcb_json_save(manifest_path, manifest, err);
+    tcb_weight_parts w = tcb_atlas_model_weights(m);
+    int rc = tcb_weights_export(bin_path, manifest_path, manifest, &w, err);
     cJSON_Delete(manifest);
     return rc;
 }
 
-int tcb_atlas_model_import(tcb_atlas_model *m, const char *bin_path, const char *manifest_path,
-                           tcb_error *err)
+int tcb_atlas_model_import(tcb_atlas_model *m, const char *bin_path, const char *manifest_path, tcb_error *err)
 {
-    cJSON *got;
-    int rc = tcb_json_load(manifest_path, &got, err);
-    if (rc) return rc;
     cJSON *want = tcb_atlas_model_manifest(m);
-    rc = tcb_manifest_check(got, want, manifest_path, err);
-    cJSON_Delete(got), cJSON_Delete(want);
-    if (rc) return rc;
     tcb_weight_parts w = tcb_atlas_model_weights(m);
-    return tcb_weights_read(bin_path, &w, err);
+    int rc = tcb_weights_import(bin_path, manifest_path, want, &w, err);
+    cJSON_Delete(want);
+    return rc;
 }

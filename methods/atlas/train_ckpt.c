@@ -36,33 +36,33 @@ static void arrays_of(const tcb_atlas_trainer *t, tcb_ckpt_array a[N_ARRAYS])
     a[2] = (tcb_ckpt_array){t->adam.v, n};
 }
 
-int tcb_atlas_train_ckpt_save(const tcb_atlas_trainer *t, const tcb_sequence *seq,
-                              uint64_t seed, double seconds, const char *path, tcb_error *err)
+/* The trainer's progress, where it keeps it. */
+static tcb_trainer_state state_of(tcb_atlas_trainer *t)
+{
+    return (tcb_trainer_state){.it = &t->it, .rng = &t->rng, .adam = &t->adam, .loss0 = &t->loss0};
+}
+
+int tcb_atlas_train_ckpt_save(const tcb_atlas_trainer *t, const tcb_sequence *seq, uint64_t seed, double seconds,
+                       const char *path, tcb_error *err)
 {
     int64_t ints[N_INTS];
     double reals[N_REALS];
     tcb_ckpt_settings s = settings_of(t, seq, seed, ints, reals);
-    tcb_train_progress p = {.it = t->it, .adam_t = t->adam.t, .loss0 = t->loss0, .seconds = seconds};
-    memcpy(p.rng, t->rng.s, sizeof p.rng);
     tcb_ckpt_array a[N_ARRAYS];
     arrays_of(t, a);
-    return tcb_train_ckpt_write(path, MAGIC, &s, &p, a, N_ARRAYS, err);
+    tcb_trainer_state st = state_of((tcb_atlas_trainer *)t); /* read only: the pointers are for load's sake */
+    return tcb_trainer_state_save(path, MAGIC, &s, &st, seconds, a, N_ARRAYS, err);
 }
 
-int tcb_atlas_train_ckpt_load(tcb_atlas_trainer *t, const tcb_sequence *seq, uint64_t seed,
-                              const char *path, double *seconds, tcb_error *err)
+int tcb_atlas_train_ckpt_load(tcb_atlas_trainer *t, const tcb_sequence *seq, uint64_t seed, const char *path,
+                       double *seconds, tcb_error *err)
 {
     int64_t ints[N_INTS];
     double reals[N_REALS];
     tcb_ckpt_settings want = settings_of(t, seq, seed, ints, reals);
     tcb_ckpt_array a[N_ARRAYS];
     arrays_of(t, a);
-    tcb_train_progress p;
-    int rc = tcb_train_ckpt_read(path, MAGIC, "an atlas training checkpoint", &want, ints[I_ITERATIONS], &p, a,
-                                 N_ARRAYS, err);
-    if (rc) return rc;
-    memcpy(t->rng.s, p.rng, sizeof p.rng);
-    t->it = p.it, t->adam.t = p.adam_t, t->loss0 = p.loss0;
-    *seconds = p.seconds;
-    return TCB_OK;
+    tcb_trainer_state st = state_of(t);
+    return tcb_trainer_state_load(path, MAGIC, "an atlas training checkpoint", &want, ints[I_ITERATIONS], &st, seconds, a, N_ARRAYS,
+                                  err);
 }
