@@ -1,4 +1,6 @@
-/* One whole training iteration of the atlas family (tcb_atlas_train_step:
+/* One whole training iteration of each trained method, beside PyTorch.
+ *
+ * The atlas family (tcb_atlas_train_step:
  * the batch drawn from the point pools, forward, the method's loss,
  * backward, Adam), for atlasnet (Chamfer, no tangents), dsr (Chamfer +
  * 0.001·L_sciso) and mca (Chamfer + 0.1·L_mc; both with the UV-Jacobians), at the paper's scale (C 1024, P 10,
@@ -22,14 +24,25 @@
  * resident set (getrusage ru_maxrss); the C process's is its peak so far,
  * as the rows run from the smaller preset up.
  *
- * Targets (issue 3): C ≥ 4× faster than PyTorch for the mca step at paper
- * scale, ≥ 3× for atlasnet, the step at ≥ 60 % of peak. Timings only;
- * nothing is asserted.
+ * cc (tcb_cc_train_step after the warm-up: the batch drawn from the pools
+ * and augmented, six network calls, the cycle losses, backward, Adam) at
+ * the paper's scale (C 1024, Z 512, H 64, L 6, 16 triplets of 2500 points)
+ * and the cpu preset's (C 256, Z 128, H 32, L 6, 8 triplets of 1000),
+ * beside train_step_cc_torch.py (the CC code's train_iteration with its
+ * latent reuse, torch.optim.Adam; data loading not timed). GFLOP/it counts
+ * cc_bench.h's products; the losses' nearest-neighbour searches are timed
+ * but not counted.
+ *
+ * Targets (issues 3, 14): C ≥ 4× faster than PyTorch for the mca step at
+ * paper scale, ≥ 3× for atlasnet and cc, the step at ≥ 60 % of peak.
+ * Timings only; nothing is asserted.
  *
  * usage: bench_train_step [--iters N] [--threads T] [--preset paper|cpu|all]
- *                         [--peak GFLOPS] [--no-torch] [--torch SCRIPT]
- * Defaults: 5 iterations, the OpenMP thread count, all presets, the peer
- * train_step_torch.py next to this file run by /usr/bin/python3. */
+ *                         [--method NAME] [--peak GFLOPS] [--no-torch]
+ *                         [--torch SCRIPT] [--cc-torch SCRIPT]
+ * Defaults: 5 iterations, the OpenMP thread count, all presets and methods
+ * (atlasnet, dsr, mca, cc), the peers train_step_torch.py and
+ * train_step_cc_torch.py next to this file run by /usr/bin/python3. */
 #include <omp.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -39,7 +52,9 @@
 #include <sys/wait.h>
 
 #include "atlas_bench.h"
+#include "cc_bench.h"
 #include "methods/atlas/train.h"
+#include "methods/cycle/train.h"
 #include "tcb/synth.h"
 
 enum { P = 10, N = 2500, FRAMES = 6, PEER_SKIPPED = 77 };
@@ -50,6 +65,15 @@ typedef struct {
 } preset;
 
 static const preset presets[] = {{"cpu", 256, 1000}, {"paper", 1024, 2500}};
+
+/* cc_method.c's presets, in the order of presets[] */
+typedef struct {
+    const char *name;
+    tcb_cc_dims d;
+    int B, N;
+} cc_preset;
+
+static const cc_preset cc_presets[] = {{"cpu", {256, 128, 32, 6}, 8, 1000}, {"paper", {1024, 512, 64, 6}, 16, 2500}};
 
 static const struct {
     const char *name;
@@ -63,7 +87,8 @@ typedef struct {
     int iters, threads, torch;
     double peak;
     const char *preset; /* NULL: all */
-    char script[4096];
+    const char *method; /* NULL: all */
+    char script[4096], cc_script[4096];
 } options;
 
 #define die(...) bench_die("bench_train_step", __VA_ARGS__)
@@ -102,15 +127,37 @@ static double time_c(const preset *pr, tcb_atlas_loss loss, const tcb_sequence *
     return ms;
 }
 
-/* Runs the PyTorch peer: 0 with *ms and *rss_kib, PEER_SKIPPED when it has
- * no torch, -1 when it failed. */
-static int time_torch(const options *o, const preset *pr, const char *method, double *ms,
-                      long *rss_kib)
+/* Mean ms per tcb_cc_train_step (after the warm-up phase: six network
+ * calls) of a fresh network, after one warm-up step. */
+static double time_cc(const cc_preset *pr, const tcb_sequence *seq, int iters)
 {
-    char cmd[8192];
-    if ((size_t)snprintf(cmd, sizeof cmd, "/usr/bin/python3 '%s' %s %d %d %d %d %d %d", o->script,
-                         method, pr->C, P, pr->M, N, o->iters, o->threads) >= sizeof cmd)
-        return -1;
+    tcb_error err = {0};
+    tcb_cc_net *net;
+    if (tcb_cc_net_create(&pr->d, &net, &err)) die("%s", err.msg);
+    tcb_rng rng;
+    tcb_rng_seed_stream(&rng, 1, "bench/train_step");
+    tcb_cc_net_init(net, &rng);
+    tcb_sequence s = *seq;
+    s.input_points = pr->N;
+    tcb_cc_train_cfg cfg = {.sampler = tcb_cc_sampler_opts_default(), .batch = pr->B, .iterations = 200000,
+                            .warmup = 0, .lr = 1e-3};
+    tcb_cc_trainer *t;
+    if (tcb_cc_trainer_create(&cfg, net, &s, 1, &t, &err)) die("%s", err.msg);
+    double value, t0 = 0;
+    for (int it = 0; it <= iters; it++) {
+        if (it == 1) t0 = bench_now_ms();
+        if (tcb_cc_train_step(t, &s, &value, &err)) die("%s", err.msg);
+    }
+    double ms = (bench_now_ms() - t0) / iters;
+    tcb_cc_trainer_free(t);
+    tcb_cc_net_free(net);
+    return ms;
+}
+
+/* Runs a PyTorch peer command: 0 with *ms and *rss_kib, PEER_SKIPPED when
+ * it has no torch, -1 when it failed. */
+static int run_peer(const char *cmd, double *ms, long *rss_kib)
+{
     fflush(stdout);
     FILE *p = popen(cmd, "r");
     if (!p) return -1;
@@ -119,6 +166,25 @@ static int time_torch(const options *o, const preset *pr, const char *method, do
     if (status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == PEER_SKIPPED)
         return PEER_SKIPPED;
     return ok && status == 0 ? 0 : -1;
+}
+
+static int time_torch(const options *o, const preset *pr, const char *method, double *ms, long *rss_kib)
+{
+    char cmd[8192];
+    if ((size_t)snprintf(cmd, sizeof cmd, "/usr/bin/python3 '%s' %s %d %d %d %d %d %d", o->script, method, pr->C, P,
+                         pr->M, N, o->iters, o->threads) >= sizeof cmd)
+        return -1;
+    return run_peer(cmd, ms, rss_kib);
+}
+
+static int time_cc_torch(const options *o, const cc_preset *pr, double *ms, long *rss_kib)
+{
+    char cmd[8192];
+    const tcb_cc_dims *d = &pr->d;
+    if ((size_t)snprintf(cmd, sizeof cmd, "/usr/bin/python3 '%s' %d %d %d %d %d %d %d %d", o->cc_script, d->C, d->Z,
+                         d->H, d->L, pr->B, pr->N, o->iters, o->threads) >= sizeof cmd)
+        return -1;
+    return run_peer(cmd, ms, rss_kib);
 }
 
 static double peak_rss_mib(void)
@@ -130,45 +196,62 @@ static double peak_rss_mib(void)
 
 static void print_header(const options *o)
 {
-    printf("atlas training step (tcb_atlas_train_step), B=4 P=%d N=%d, %d thread(s), mean of %d "
-           "iteration(s) after 1 warm-up\n", P, N, o->threads, o->iters);
-    printf("GFLOP/it = 2 x minimal multiply-adds of forward + backward (bench/atlas_bench.h):\n"
+    printf("training step, %d thread(s), mean of %d iteration(s) after 1 warm-up\n", o->threads, o->iters);
+    printf("atlas (tcb_atlas_train_step), B=4 P=%d N=%d; GFLOP/it = 2 x minimal multiply-adds of\n"
+           "  forward + backward (bench/atlas_bench.h):\n"
            "  encoder B*N*(3*64 + 64*128 + 128*C) + 2*B*C^2; per patch B*C*H1 + B*m*2*H1\n"
            "  + (1+nt)*B*m*(H1*H2 + H2*H3 + 3*H3), m = M/P, H1 = C+2, H2 = H1/2, H3 = H1/4,\n"
            "  nt = 2 tangents (dsr, mca) or 0 (atlasnet); backward ~2x (exact count in the header);\n"
-           "  loss and Adam not counted. Peak %.0f GFLOP/s.\n", o->peak);
-    printf("%-6s %-9s %8s %9s %8s %6s %10s %8s %9s %9s\n", "preset", "method", "GFLOP/it",
-           "C ms/it", "GFLOP/s", "%peak", "torch ms", "torch/C", "C RSS MiB", "torch MiB");
+           "cc (tcb_cc_train_step, six network calls; bench/cc_bench.h): 6 encoders\n"
+           "  B*N*(3*64 + 64*128 + 128*C) + B*C*Z, 6 decoders B*(2Z*Z + Z*Z/2 + Z/2*K)\n"
+           "  + B*N*sum_l(din^2 + din*dout); backward ~2x.\n"
+           "Losses, nearest neighbours and Adam not counted. Peak %.0f GFLOP/s.\n", P, N, o->peak);
+    printf("%-6s %-9s %8s %9s %8s %6s %10s %8s %9s %9s\n", "preset", "method", "GFLOP/it", "C ms/it", "GFLOP/s",
+           "%peak", "torch ms", "torch/C", "C RSS MiB", "torch MiB");
 }
 
-static void run_row(options *o, const preset *pr, int k, const tcb_sequence *seq)
+/* One row: the C figures and the peer's (rc 0), or n/a. */
+static void print_row(options *o, const char *preset, const char *method, double gflop, double ms, int rc,
+                      double tms, long rss, const char *script)
 {
-    double fwd, bwd;
-    bench_atlas_macs(pr->C, P, pr->M, 4, N, methods[k].nt, &fwd, &bwd);
-    double gflop = 2 * (fwd + bwd) * 1e-9;
-    double ms = time_c(pr, methods[k].loss, seq, o->iters), gfs = gflop / ms * 1e3;
-    double c_rss = peak_rss_mib(), tms = 0;
-    long rss = 0;
-    int rc = o->torch ? time_torch(o, pr, methods[k].name, &tms, &rss) : PEER_SKIPPED;
-    printf("%-6s %-9s %8.1f %9.1f %8.1f %5.0f%%", pr->name, methods[k].name, gflop, ms, gfs,
-           100 * gfs / o->peak);
-    if (rc == 0)
-        printf(" %10.1f %8.2f %9.0f %9.0f\n", tms, tms / ms, c_rss, rss / 1024.0);
-    else
-        printf(" %10s %8s %9.0f %9s\n", "n/a", "n/a", c_rss, "n/a");
+    double gfs = gflop / ms * 1e3, c_rss = peak_rss_mib();
+    printf("%-6s %-9s %8.1f %9.1f %8.1f %5.0f%%", preset, method, gflop, ms, gfs, 100 * gfs / o->peak);
+    if (rc == 0) printf(" %10.1f %8.2f %9.0f %9.0f\n", tms, tms / ms, c_rss, rss / 1024.0);
+    else printf(" %10s %8s %9.0f %9s\n", "n/a", "n/a", c_rss, "n/a");
     if (rc == PEER_SKIPPED && o->torch) {
         printf("PyTorch peer: unavailable (install python3-torch)\n");
         o->torch = 0;
     } else if (rc < 0) {
-        printf("PyTorch peer: failed (%s)\n", o->script);
+        printf("PyTorch peer: failed (%s)\n", script);
     }
     fflush(stdout);
+}
+
+static void run_row(options *o, const preset *pr, int k, const tcb_sequence *seq)
+{
+    double fwd, bwd, tms = 0;
+    long rss = 0;
+    bench_atlas_macs(pr->C, P, pr->M, 4, N, methods[k].nt, &fwd, &bwd);
+    double ms = time_c(pr, methods[k].loss, seq, o->iters);
+    int rc = o->torch ? time_torch(o, pr, methods[k].name, &tms, &rss) : PEER_SKIPPED;
+    print_row(o, pr->name, methods[k].name, 2 * (fwd + bwd) * 1e-9, ms, rc, tms, rss, o->script);
+}
+
+static void run_cc_row(options *o, const cc_preset *pr, const tcb_sequence *seq)
+{
+    double fwd, bwd, tms = 0;
+    long rss = 0;
+    bench_cc_macs(&pr->d, pr->B, pr->N, &fwd, &bwd);
+    double ms = time_cc(pr, seq, o->iters);
+    int rc = o->torch ? time_cc_torch(o, pr, &tms, &rss) : PEER_SKIPPED;
+    print_row(o, pr->name, "cc", 2 * (fwd + bwd) * 1e-9, ms, rc, tms, rss, o->cc_script);
 }
 
 static void parse(int argc, char **argv, options *o)
 {
     *o = (options){.iters = 5, .threads = omp_get_max_threads(), .torch = 1, .peak = 230};
     bench_sibling_path(o->script, sizeof o->script, __FILE__, "train_step_torch.py");
+    bench_sibling_path(o->cc_script, sizeof o->cc_script, __FILE__, "train_step_cc_torch.py");
     for (int a = 1; a < argc; a++) {
         const char *v = a + 1 < argc ? argv[a + 1] : NULL;
         if (strcmp(argv[a], "--no-torch") == 0) o->torch = 0;
@@ -177,14 +260,20 @@ static void parse(int argc, char **argv, options *o)
         else if (strcmp(argv[a], "--threads") == 0) o->threads = bench_positive_int(v, "--threads", "top of bench/train_step.c"), a++;
         else if (strcmp(argv[a], "--peak") == 0) o->peak = atof(v), a++;
         else if (strcmp(argv[a], "--preset") == 0) o->preset = strcmp(v, "all") ? v : NULL, a++;
+        else if (strcmp(argv[a], "--method") == 0) o->method = v, a++;
         else if (strcmp(argv[a], "--torch") == 0)
             snprintf(o->script, sizeof o->script, "%s", v), a++;
+        else if (strcmp(argv[a], "--cc-torch") == 0)
+            snprintf(o->cc_script, sizeof o->cc_script, "%s", v), a++;
         else die("bad argument %s (usage: top of bench/train_step.c)", argv[a]);
     }
     if (o->iters < 1 || o->threads < 1 || o->peak <= 0)
         die("--iters, --threads and --peak must be > 0");
     if (o->preset && strcmp(o->preset, "cpu") && strcmp(o->preset, "paper"))
         die("--preset must be paper, cpu or all");
+    if (o->method && strcmp(o->method, "atlasnet") && strcmp(o->method, "dsr") && strcmp(o->method, "mca") &&
+        strcmp(o->method, "cc"))
+        die("--method must be atlasnet, dsr, mca or cc");
 }
 
 int main(int argc, char **argv)
@@ -196,10 +285,12 @@ int main(int argc, char **argv)
     tcb_sequence seq = {0};
     make_sequence(&seq);
     print_header(&o);
-    for (size_t i = 0; i < sizeof presets / sizeof *presets; i++)
-        for (size_t k = 0; k < sizeof methods / sizeof *methods; k++)
-            if (!o.preset || strcmp(o.preset, presets[i].name) == 0)
-                run_row(&o, &presets[i], (int)k, &seq);
+    for (size_t i = 0; i < sizeof presets / sizeof *presets; i++) {
+        int want = !o.preset || strcmp(o.preset, presets[i].name) == 0;
+        for (size_t k = 0; want && k < sizeof methods / sizeof *methods; k++)
+            if (!o.method || strcmp(o.method, methods[k].name) == 0) run_row(&o, &presets[i], (int)k, &seq);
+        if (want && (!o.method || strcmp(o.method, "cc") == 0)) run_cc_row(&o, &cc_presets[i], &seq);
+    }
     tcb_sequence_free(&seq);
     return 0;
 }

@@ -79,7 +79,7 @@ static void term_progress(void *ctx, double done, double total, const char *labe
 static void term_log(void *ctx, tcb_log_level level, const char *msg)
 {
     tcb_term_progress *tp = ctx;
-    if (level == TCB_LOG_DEBUG || (tp->quiet && level < TCB_LOG_WARN)) return;
+    if ((level == TCB_LOG_DEBUG && !tp->verbose) || (tp->quiet && level < TCB_LOG_WARN)) return;
     if (tp->is_tty) fputs("\r\033[K", tp->out);
     fprintf(tp->out, "%s%s\n", level == TCB_LOG_WARN ? "warning: " : "", msg);
     fflush(tp->out);

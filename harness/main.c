@@ -17,7 +17,7 @@
 
 enum {
     F_OUT, F_ONLY, F_FORCE, F_QUIET, F_REPORT, F_SEED, F_FRAMES, F_SEQUENCE, F_UPDATE,
-    F_PLUGIN, F_THREADS, F_HELP, F_COUNT
+    F_PLUGIN, F_THREADS, F_VERBOSE, F_HELP, F_COUNT
 };
 #define BIT(f) (1u << (f))
 
@@ -28,7 +28,8 @@ static const struct {
     [F_OUT] = {"--out", 1},      [F_ONLY] = {"--only", 1},       [F_FORCE] = {"--force", 0},
     [F_QUIET] = {"--quiet", 0},  [F_REPORT] = {"--report", 0},   [F_SEED] = {"--seed", 1},
     [F_FRAMES] = {"--frames", 1}, [F_SEQUENCE] = {"--sequence", 1}, [F_UPDATE] = {"--update", 0},
-    [F_PLUGIN] = {"--plugin", 1}, [F_THREADS] = {"--threads", 1}, [F_HELP] = {"--help", 0},
+    [F_PLUGIN] = {"--plugin", 1}, [F_THREADS] = {"--threads", 1}, [F_VERBOSE] = {"--verbose", 0},
+    [F_HELP] = {"--help", 0},
 };
 
 #define MAX_PLUGINS 64
@@ -100,6 +101,7 @@ static int cmd_run(const cli *c)
     if (threads > 0) cfg.threads = (int)(threads > 1024 ? 1024 : threads);
     tcb_term_progress tp;
     tcb_term_progress_init(&tp, stderr, c->set[F_QUIET] ? 1 : -1);
+    tp.verbose = c->set[F_VERBOSE];
     tcb_run_opts opts = {c->value[F_OUT], c->value[F_ONLY], c->set[F_FORCE],
                          tcb_term_progress_reporter(&tp)};
     tcb_run_stats st;
@@ -248,10 +250,11 @@ static int cmd_version(const cli *c)
 static int cmd_help(const cli *c);
 
 static const command commands[] = {
-    {"run", cmd_run, BIT(F_OUT) | BIT(F_ONLY) | BIT(F_FORCE) | BIT(F_QUIET) | BIT(F_REPORT) | BIT(F_THREADS), 1, 1,
+    {"run", cmd_run,
+     BIT(F_OUT) | BIT(F_ONLY) | BIT(F_FORCE) | BIT(F_QUIET) | BIT(F_REPORT) | BIT(F_THREADS) | BIT(F_VERBOSE), 1, 1,
      "CONFIG",
      "usage: tcbench run CONFIG [--out DIR] [--only METHOD] [--threads N] [--force] [--quiet]\n"
-     "                  [--report] [--plugin SO]...\n"
+     "                  [--verbose] [--report] [--plugin SO]...\n"
      "\n"
      "Runs every (dataset, sequence, method, seed) cell of the config and writes one\n"
      "result file per cell. Finished cells are skipped, so rerunning a killed run\n"
@@ -264,6 +267,7 @@ static const command commands[] = {
      "                 processes with --only and --threads 1 use two cores more evenly\n"
      "  --force        recompute cells that are already finished\n"
      "  --quiet        no progress output (also when the CI variable is set)\n"
+     "  --verbose      also the methods' debug lines (a training's loss every 1 000 iterations)\n"
      "  --report       write the report when the run is done\n"
      "  --plugin SO    load out-of-tree methods from a shared object (repeatable)\n"
      "\n"

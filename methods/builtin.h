@@ -10,5 +10,6 @@ extern const tcb_method_ops tcb_method_nricp;
 extern const tcb_method_ops tcb_method_atlasnet;
 extern const tcb_method_ops tcb_method_dsr;
 extern const tcb_method_ops tcb_method_mca;
+extern const tcb_method_ops tcb_method_cc;
 
 #endif

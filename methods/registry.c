@@ -20,6 +20,7 @@ static const tcb_method_ops *const builtins[] = {
     &tcb_method_atlasnet,
     &tcb_method_dsr,
     &tcb_method_mca,
+    &tcb_method_cc,
 };
 #define N_BUILTINS ((int)(sizeof builtins / sizeof builtins[0]))
 

@@ -13,14 +13,16 @@
  * depend on every row), with x̂ = (x − μ)/σ and the column sums of dy and
  * dy·x̂:  dx = γ/σ · (dy − Σdy/n − x̂·Σ(dy·x̂)/n),  dβ += Σdy,  dγ += Σ dy·x̂.
  *
- * Reductions over rows are column-chunked with a fixed order and summed in
- * double, so results do not depend on the thread count. */
+ * Reductions over rows run over a fixed partition of the rows and are
+ * summed in double, so results do not depend on the thread count. The
+ * per-channel scratch lives on the stack (≈ 0.4 MiB at TCB_BN_MAX_C). */
 #ifndef TCB_NEURAL_BATCHNORM_H
 #define TCB_NEURAL_BATCHNORM_H
 
 #include <stddef.h>
 
 #define TCB_BN_EPS 1e-5
+#define TCB_BN_MAX_C 4096 /* channels of one layer */
 #define TCB_BN_MOMENTUM 0.1
 
 /* A layer's tensors: γ and β are trained parameters (PyTorch's weight and
@@ -34,17 +36,19 @@ typedef struct tcb_batchnorm {
 
 /* Views the layer at params + *poff (γ, β: 2C floats) and, when buffers is
  * not NULL, buffers + *boff (running mean, var: 2C floats), advancing the
- * offsets. */
+ * offsets. 1 ≤ C ≤ TCB_BN_MAX_C. */
 void tcb_batchnorm_bind(tcb_batchnorm *bn, float *params, size_t *poff, float *buffers, size_t *boff, int C);
 
 /* PyTorch's initial running statistics: mean 0, variance 1. */
 void tcb_batchnorm_reset_running(const tcb_batchnorm *bn);
 
-/* Training mode, x [n][C] → y [n][C] (y may alias x), n ≥ 2. Keeps what
- * backward needs: xhat [n][C] (x̂) and rstd [C] (1/√(σ² + eps)); the batch
- * mean and biased variance go to mu, var2 [C] (for update_running). */
+/* Training mode, x [n][C] → y [n][C] (y may alias x), n ≥ 2, with the
+ * ReLU that follows it fused in when relu (y = max(0, BN(x))): one pass
+ * over the data instead of two. Keeps what backward needs: xhat [n][C] (x̂)
+ * and rstd [C] (1/√(σ² + eps)); the batch mean and biased variance go to
+ * mu, var2 [C] (for update_running). */
 void tcb_batchnorm_forward_train(const tcb_batchnorm *bn, float *y, float *xhat, float *rstd, float *mu,
-                                 float *var2, const float *x, int n);
+                                 float *var2, const float *x, int n, int relu);
 
 /* Moves bn's running statistics towards batch statistics (mu, var2 from a
  * training forward over n rows). Separate from the forward so a batch whose
@@ -52,12 +56,15 @@ void tcb_batchnorm_forward_train(const tcb_batchnorm *bn, float *y, float *xhat,
  * when a module is called twice. */
 void tcb_batchnorm_update_running(const tcb_batchnorm *bn, const float *mu, const float *var2, int n);
 
-/* Evaluation mode with the running statistics, x [n][C] → y [n][C]. */
-void tcb_batchnorm_forward_eval(const tcb_batchnorm *bn, float *y, const float *x, int n);
+/* Evaluation mode with the running statistics, x [n][C] → y [n][C], the
+ * ReLU fused in when relu. */
+void tcb_batchnorm_forward_eval(const tcb_batchnorm *bn, float *y, const float *x, int n, int relu);
 
 /* Training-mode backward: dx [n][C] (may alias dy), grad->gamma and
- * grad->beta [C] accumulated, from dy [n][C] and the forward's xhat, rstd. */
+ * grad->beta [C] accumulated, from dy [n][C] and the forward's xhat, rstd.
+ * y: the forward's output when its ReLU was fused in (dy is masked by
+ * y > 0 first), else NULL. */
 void tcb_batchnorm_backward(const tcb_batchnorm *bn, const tcb_batchnorm *grad, float *dx, const float *dy,
-                            const float *xhat, const float *rstd, int n);
+                            const float *y, const float *xhat, const float *rstd, int n);
 
 #endif

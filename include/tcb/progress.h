@@ -4,7 +4,8 @@
  * context), never by printing. The terminal implementation draws a bar on a
  * TTY, prints a plain line when a task starts and ends (and every 10 s in
  * between) when the output is not a TTY, and prints
- * nothing but warnings when quiet (CI=true or --quiet). */
+ * nothing but warnings when quiet (CI=true or --quiet); debug lines only
+ * when verbose. */
 #ifndef TCB_PROGRESS_H
 #define TCB_PROGRESS_H
 
@@ -34,6 +35,7 @@ typedef struct tcb_term_progress {
     FILE *out;
     int is_tty;
     int quiet;
+    int verbose;          /* also TCB_LOG_DEBUG lines (not when quiet) */
     double last_emit_s;   /* monotonic time of the last redraw / line */
     char label[128];
 } tcb_term_progress;

@@ -64,16 +64,17 @@ size_t tcb_cc_deform_scratch_floats(const tcb_cc_net *net, int B, int N)
     return 3 * (size_t)B * N * widest(net) + (size_t)B * (net->K + 4 * (size_t)net->d.Z);
 }
 
-/* y = BN(x) in either mode; a training forward records x̂ and the stats
- * (rstd, mean, var) and moves the running statistics. */
+/* y = ReLU(BN(x)) (every batch norm of the decoder has its ReLU) in either
+ * mode; a training forward records x̂ and the stats (rstd, mean, var) and
+ * moves the running statistics. */
 static void norm(const tcb_batchnorm *bn, float *y, float *xhat, float *st, const float *x, int n, int train)
 {
     if (!train) {
-        tcb_batchnorm_forward_eval(bn, y, x, n);
+        tcb_batchnorm_forward_eval(bn, y, x, n, 1);
         return;
     }
     int C = bn->C;
-    tcb_batchnorm_forward_train(bn, y, xhat, st, st + C, st + 2 * C, x, n);
+    tcb_batchnorm_forward_train(bn, y, xhat, st, st + C, st + 2 * C, x, n, 1);
     tcb_batchnorm_update_running(bn, st + C, st + 2 * C, n);
 }
 
@@ -89,10 +90,8 @@ static void predictor_forward(const tcb_cc_predictor *p, tcb_cc_deform_cache *c,
     }
     tcb_linear_forward(c->q1, c->lat, p->fc1.W, p->fc1.b, B, 0, 2 * Z, Z);
     norm(&p->bn1, c->q1, c->xq1, c->sq1, c->q1, B, train);
-    tcb_relu_forward(c->q1, c->q1, (int64_t)B * Z);
     tcb_linear_forward(c->q2, c->q1, p->fc2.W, p->fc2.b, B, 0, Z, Z / 2);
     norm(&p->bn2, c->q2, c->xq2, c->sq2, c->q2, B, train);
-    tcb_relu_forward(c->q2, c->q2, (int64_t)B * (Z / 2));
     tcb_linear_forward(c->theta, c->q2, p->fc3.W, p->fc3.b, B, 0, Z / 2, (int)c->K);
 }
 
@@ -126,11 +125,9 @@ void tcb_cc_deform_forward(const tcb_cc_net *net, tcb_cc_deform_cache *c, float 
         const tcb_cc_meta_layer *m = &net->p.meta[l];
         predicted_forward(m, c, c->u[l], v, h);
         norm(&m->bn0, c->r[l], c->xh0[l], c->s0[l], v, R, train);
-        tcb_relu_forward(c->r[l], c->r[l], (int64_t)R * m->din);
         if (m->bn1.C) {
             tcb_linear_forward(pre, c->r[l], m->conv.W, m->conv.b, R, 0, m->din, m->dout);
             norm(&m->bn1, c->o[l], c->xh1[l], c->s1[l], pre, R, train);
-            tcb_relu_forward(c->o[l], c->o[l], (int64_t)R * m->dout);
         } else {
             tcb_linear_forward(c->o[l], c->r[l], m->conv.W, m->conv.b, R, 0, m->din, m->dout);
             for (size_t k = 0; k < (size_t)R * m->dout; k++) c->o[l][k] = tanhf(c->o[l][k]);
@@ -170,13 +167,13 @@ static void predictor_backward(const tcb_cc_predictor *p, const tcb_cc_predictor
 {
     int B = c->B, Z = c->Z;
     float *d2 = scratch, *d1 = d2 + (size_t)B * Z, *dlat = d1 + (size_t)B * Z;
+    /* fc1 and fc2 feed training-mode batch norms: their biases' gradients
+     * are exactly zero (the batch mean is subtracted), not summed */
     tcb_linear_backward(d2, g->fc3.W, g->fc3.b, dtheta, c->q2, p->fc3.W, B, 0, Z / 2, (int)c->K);
-    tcb_relu_backward(d2, d2, c->q2, (int64_t)B * (Z / 2));
-    tcb_batchnorm_backward(&p->bn2, &g->bn2, d2, d2, c->xq2, c->sq2, B);
-    tcb_linear_backward(d1, g->fc2.W, g->fc2.b, d2, c->q1, p->fc2.W, B, 0, Z, Z / 2);
-    tcb_relu_backward(d1, d1, c->q1, (int64_t)B * Z);
-    tcb_batchnorm_backward(&p->bn1, &g->bn1, d1, d1, c->xq1, c->sq1, B);
-    tcb_linear_backward(dlat, g->fc1.W, g->fc1.b, d1, c->lat, p->fc1.W, B, 0, 2 * Z, Z);
+    tcb_batchnorm_backward(&p->bn2, &g->bn2, d2, d2, c->q2, c->xq2, c->sq2, B);
+    tcb_linear_backward(d1, g->fc2.W, NULL, d2, c->q1, p->fc2.W, B, 0, Z, Z / 2);
+    tcb_batchnorm_backward(&p->bn1, &g->bn1, d1, d1, c->q1, c->xq1, c->sq1, B);
+    tcb_linear_backward(dlat, g->fc1.W, NULL, d1, c->lat, p->fc1.W, B, 0, 2 * Z, Z);
     for (int b = 0; b < B; b++)
         for (int j = 0; j < Z; j++) {
             dzx[(size_t)b * Z + j] += dlat[(size_t)b * 2 * Z + j];
@@ -197,13 +194,12 @@ void tcb_cc_deform_backward(tcb_cc_net *net, tcb_cc_deform_cache *c, float *scra
         size_t n_out = (size_t)R * m->dout;
         if (m == last)
             for (size_t k = 0; k < n_out; k++) dc[k] = dh[k] * (1.0f - c->o[l][k] * c->o[l][k]);
-        else {
-            tcb_relu_backward(dc, dh, c->o[l], (int64_t)n_out);
-            tcb_batchnorm_backward(&m->bn1, &gm->bn1, dc, dc, c->xh1[l], c->s1[l], R);
-        }
-        tcb_linear_backward(dr, gm->conv.W, gm->conv.b, dc, c->r[l], m->conv.W, R, 0, m->din, m->dout);
-        tcb_relu_backward(dr, dr, c->r[l], (int64_t)R * m->din);
-        tcb_batchnorm_backward(&m->bn0, &gm->bn0, dr, dr, c->xh0[l], c->s0[l], R);
+        else
+            tcb_batchnorm_backward(&m->bn1, &gm->bn1, dc, dh, c->o[l], c->xh1[l], c->s1[l], R);
+        /* a conv followed by bn1 has an exactly zero bias gradient: not summed */
+        tcb_linear_backward(dr, gm->conv.W, m == last ? gm->conv.b : NULL, dc, c->r[l], m->conv.W, R, 0, m->din,
+                            m->dout);
+        tcb_batchnorm_backward(&m->bn0, &gm->bn0, dr, dr, c->r[l], c->xh0[l], c->s0[l], R);
         predicted_backward(m, c, dtheta, dh, dr, c->u[l]);
     }
     predictor_backward(&net->p.pred, &net->g.pred, c, rest, dtheta, dzx, dzy);

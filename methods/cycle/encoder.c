@@ -57,14 +57,15 @@ size_t tcb_cc_encoder_scratch_floats(const tcb_cc_dims *d, int B, int N)
 
 /* y = BN(x) over n rows in either mode, recording x̂ and the statistics of
  * a training forward into xhat and st (rstd, mean, var). */
-static void norm(const tcb_batchnorm *bn, float *y, float *xhat, float *st, const float *x, int n, int train)
+static void norm(const tcb_batchnorm *bn, float *y, float *xhat, float *st, const float *x, int n, int train,
+                 int relu)
 {
     if (!train) {
-        tcb_batchnorm_forward_eval(bn, y, x, n);
+        tcb_batchnorm_forward_eval(bn, y, x, n, relu);
         return;
     }
     int C = bn->C;
-    tcb_batchnorm_forward_train(bn, y, xhat, st, st + C, st + 2 * C, x, n);
+    tcb_batchnorm_forward_train(bn, y, xhat, st, st + C, st + 2 * C, x, n, relu);
     tcb_batchnorm_update_running(bn, st + C, st + 2 * C, n);
 }
 
@@ -75,17 +76,14 @@ void tcb_cc_encoder_forward(const tcb_cc_encoder *e, tcb_cc_encoder_cache *c, fl
     float *pre = scratch; /* [R][max(C, 128)] pre-activations */
     c->x = clouds;
     tcb_linear_forward(pre, clouds, e->conv1.W, e->conv1.b, R, 0, 3, TCB_CC_ENC1);
-    norm(&e->bn1, c->h1, c->xh1, stats_of(c, BN1), pre, R, train);
-    tcb_relu_forward(c->h1, c->h1, (int64_t)R * TCB_CC_ENC1);
+    norm(&e->bn1, c->h1, c->xh1, stats_of(c, BN1), pre, R, train, 1);
     tcb_linear_forward(pre, c->h1, e->conv2.W, e->conv2.b, R, 0, TCB_CC_ENC1, TCB_CC_ENC2);
-    norm(&e->bn2, c->h2, c->xh2, stats_of(c, BN2), pre, R, train);
-    tcb_relu_forward(c->h2, c->h2, (int64_t)R * TCB_CC_ENC2);
+    norm(&e->bn2, c->h2, c->xh2, stats_of(c, BN2), pre, R, train, 1);
     tcb_linear_forward(pre, c->h2, e->conv3.W, e->conv3.b, R, 0, TCB_CC_ENC2, C);
-    norm(&e->bn3, pre, c->xh3, stats_of(c, BN3), pre, R, train);
+    norm(&e->bn3, pre, c->xh3, stats_of(c, BN3), pre, R, train, 0);
     tcb_maxpool_forward(c->g, c->arg, pre, B, N, C);
     tcb_linear_forward(c->z, c->g, e->fc.W, e->fc.b, B, 0, C, Z);
-    norm(&e->bnf, c->z, c->xhf, stats_of(c, BNF), c->z, B, train);
-    tcb_relu_forward(c->z, c->z, (int64_t)B * Z);
+    norm(&e->bnf, c->z, c->xhf, stats_of(c, BNF), c->z, B, train, 1);
 }
 
 void tcb_cc_encoder_count_again(const tcb_cc_encoder *e, const tcb_cc_encoder_cache *c)
@@ -108,19 +106,19 @@ void tcb_cc_encoder_backward(const tcb_cc_encoder *e, const tcb_cc_encoder *grad
     float *d1 = d2 + (size_t)R * TCB_CC_ENC2;      /* [R][64] */
     float *dg = d1 + (size_t)R * TCB_CC_ENC1;      /* [B][C] */
     float *df = dg + (size_t)B * C;                /* [B][Z] */
-    tcb_relu_backward(df, dz, c->z, (int64_t)B * Z);
-    tcb_batchnorm_backward(&e->bnf, &grad->bnf, df, df, c->xhf, stats_of(c, BNF), B);
-    tcb_linear_backward(dg, grad->fc.W, grad->fc.b, df, c->g, e->fc.W, B, 0, C, Z);
+    /* every layer here feeds a training-mode batch norm, which subtracts
+     * the batch mean: the biases' gradients are exactly zero (PyTorch
+     * computes them as rounding noise), so they are not summed (db NULL) */
+    tcb_batchnorm_backward(&e->bnf, &grad->bnf, df, dz, c->z, c->xhf, stats_of(c, BNF), B);
+    tcb_linear_backward(dg, grad->fc.W, NULL, df, c->g, e->fc.W, B, 0, C, Z);
     /* the max-pool routes each (cloud, channel) gradient to its one point */
     memset(d3, 0, (size_t)R * C * sizeof(float));
     for (int b = 0; b < B; b++)
         for (int j = 0; j < C; j++) d3[((size_t)b * N + c->arg[(size_t)b * C + j]) * C + j] = dg[(size_t)b * C + j];
-    tcb_batchnorm_backward(&e->bn3, &grad->bn3, d3, d3, c->xh3, stats_of(c, BN3), R);
-    tcb_linear_backward(d2, grad->conv3.W, grad->conv3.b, d3, c->h2, e->conv3.W, R, 0, TCB_CC_ENC2, C);
-    tcb_relu_backward(d2, d2, c->h2, (int64_t)R * TCB_CC_ENC2);
-    tcb_batchnorm_backward(&e->bn2, &grad->bn2, d2, d2, c->xh2, stats_of(c, BN2), R);
-    tcb_linear_backward(d1, grad->conv2.W, grad->conv2.b, d2, c->h1, e->conv2.W, R, 0, TCB_CC_ENC1, TCB_CC_ENC2);
-    tcb_relu_backward(d1, d1, c->h1, (int64_t)R * TCB_CC_ENC1);
-    tcb_batchnorm_backward(&e->bn1, &grad->bn1, d1, d1, c->xh1, stats_of(c, BN1), R);
-    tcb_linear_backward(NULL, grad->conv1.W, grad->conv1.b, d1, c->x, e->conv1.W, R, 0, 3, TCB_CC_ENC1);
+    tcb_batchnorm_backward(&e->bn3, &grad->bn3, d3, d3, NULL, c->xh3, stats_of(c, BN3), R);
+    tcb_linear_backward(d2, grad->conv3.W, NULL, d3, c->h2, e->conv3.W, R, 0, TCB_CC_ENC2, C);
+    tcb_batchnorm_backward(&e->bn2, &grad->bn2, d2, d2, c->h2, c->xh2, stats_of(c, BN2), R);
+    tcb_linear_backward(d1, grad->conv2.W, NULL, d2, c->h1, e->conv2.W, R, 0, TCB_CC_ENC1, TCB_CC_ENC2);
+    tcb_batchnorm_backward(&e->bn1, &grad->bn1, d1, d1, c->h1, c->xh1, stats_of(c, BN1), R);
+    tcb_linear_backward(NULL, grad->conv1.W, NULL, d1, c->x, e->conv1.W, R, 0, 3, TCB_CC_ENC1);
 }

@@ -194,7 +194,7 @@ static void check_layer(int n, int C, tcb_rng *rng)
     fill_uniform(rng, a, len, -1, 1);
 
     /* training forward */
-    tcb_batchnorm_forward_train(&L.bn, y, xhat, rstd, mu, var2, x, n);
+    tcb_batchnorm_forward_train(&L.bn, y, xhat, rstd, mu, var2, x, n, 0);
     bn_ctx c = {to_double(x, len), to_double(L.bn.gamma, C), to_double(L.bn.beta, C), to_double(a, len), n, C};
     double *yref = dalloc(len), *xhref = dalloc(len), one[512], zero[512], muref[512], varref[512], rsref[512];
     for (int k = 0; k < C; k++) one[k] = 1.0, zero[k] = 0.0;
@@ -209,7 +209,7 @@ static void check_layer(int n, int C, tcb_rng *rng)
     /* in place (y aliasing x) gives the same bits */
     float *yy = falloc(len);
     memcpy(yy, x, len * sizeof(float));
-    tcb_batchnorm_forward_train(&L.bn, yy, xhat, rstd, mu, var2, yy, n);
+    tcb_batchnorm_forward_train(&L.bn, yy, xhat, rstd, mu, var2, yy, n, 0);
     assert_memory_equal(yy, y, len * sizeof(float));
     free(yy);
 
@@ -229,19 +229,19 @@ static void check_layer(int n, int C, tcb_rng *rng)
 
     /* eval forward with those running statistics; in place too */
     for (int k = 0; k < C; k++) rm[k] = L.bn.mean[k], rv[k] = L.bn.var[k];
-    tcb_batchnorm_forward_eval(&L.bn, y, x, n);
+    tcb_batchnorm_forward_eval(&L.bn, y, x, n, 0);
     ref_eval(yref, c.x, c.gamma, c.beta, rm, rv, n, C);
     check_forward("eval y", y, yref, len);
     yy = falloc(len);
     memcpy(yy, x, len * sizeof(float));
-    tcb_batchnorm_forward_eval(&L.bn, yy, yy, n);
+    tcb_batchnorm_forward_eval(&L.bn, yy, yy, n, 0);
     assert_memory_equal(yy, y, len * sizeof(float));
     for (int k = 0; k < C; k++) assert_true(L.bn.mean[k] == (float)rm[k] && L.bn.var[k] == (float)rv[k]);
     free(yy);
 
     /* backward of L = Σ a·y through the training forward */
-    tcb_batchnorm_forward_train(&L.bn, y, xhat, rstd, mu, var2, x, n);
-    tcb_batchnorm_backward(&L.bn, &L.g, dx, a, xhat, rstd, n);
+    tcb_batchnorm_forward_train(&L.bn, y, xhat, rstd, mu, var2, x, n, 0);
+    tcb_batchnorm_backward(&L.bn, &L.g, dx, a, NULL, xhat, rstd, n);
     check_grad("dx", bn_objective, &c, c.x, dx, len);
     check_grad("dgamma", bn_objective, &c, c.gamma, L.g.gamma, C);
     check_grad("dbeta", bn_objective, &c, c.beta, L.g.beta, C);
@@ -249,7 +249,7 @@ static void check_layer(int n, int C, tcb_rng *rng)
     /* dx aliasing dy: the same bits; dγ, dβ accumulate (now doubled) */
     float *dd = falloc(len), g0 = L.g.gamma[0], b0 = L.g.beta[C - 1];
     memcpy(dd, a, len * sizeof(float));
-    tcb_batchnorm_backward(&L.bn, &L.g, dd, dd, xhat, rstd, n);
+    tcb_batchnorm_backward(&L.bn, &L.g, dd, dd, NULL, xhat, rstd, n);
     assert_memory_equal(dd, dx, len * sizeof(float));
     assert_near(L.g.gamma[0], 2.0f * g0, 1e-6 * fabs(g0));
     assert_near(L.g.beta[C - 1], 2.0f * b0, 1e-6 * fabs(b0));
@@ -281,7 +281,7 @@ static void test_offset_input(void **state)
     float x[n * C], y[n * C], xhat[n * C], rstd[C], mu[C], var2[C];
     for (int r = 0; r < n; r++)
         for (int c = 0; c < C; c++) x[r * C + c] = (float)(100.0 * (c + 1) + 0.1 * (2.0 * tcb_rng_uniform(&rng) - 1.0));
-    tcb_batchnorm_forward_train(&L.bn, y, xhat, rstd, mu, var2, x, n);
+    tcb_batchnorm_forward_train(&L.bn, y, xhat, rstd, mu, var2, x, n, 0);
     double *xd = to_double(x, n * C), *gd = to_double(L.bn.gamma, C), *bd = to_double(L.bn.beta, C);
     double yref[n * C], muref[C], varref[C];
     ref_train(yref, muref, varref, xd, gd, bd, n, C);
@@ -293,10 +293,56 @@ static void test_offset_input(void **state)
         L.bn.mean[c] = (float)(100.0 * (c + 1) + 0.01), L.bn.var[c] = 2e-3f;
         rm[c] = L.bn.mean[c], rv[c] = L.bn.var[c];
     }
-    tcb_batchnorm_forward_eval(&L.bn, y, x, n);
+    tcb_batchnorm_forward_eval(&L.bn, y, x, n, 0);
     ref_eval(yref, xd, gd, bd, rm, rv, n, C);
     check_forward("offset eval y", y, yref, n * C);
     free(xd), free(gd), free(bd);
+}
+
+/* The fused ReLU: forward_train / forward_eval with relu give exactly
+ * max(0, ·) of the plain outputs (x̂ and the statistics unchanged), and the
+ * backward given the fused output y equals the plain backward of dy masked
+ * by y > 0. The inputs straddle zero, so both sides of the kink occur. */
+static void test_fused_relu(void **state)
+{
+    (void)state;
+    enum { n = 40, C = 24 };
+    size_t len = (size_t)n * C;
+    tcb_rng rng;
+    tcb_rng_seed_stream(&rng, 1, "test/batchnorm/relu");
+    layer L;
+    layer_make(&L, C, &rng);
+    float *x = falloc(len), *a = falloc(len), *y = falloc(len), *yr = falloc(len), *xh = falloc(len),
+          *xhr = falloc(len), *dx = falloc(len), *dxr = falloc(len), *masked = falloc(len);
+    float st[3][C], str[3][C];
+    fill_input(&rng, x, n, C);
+    fill_uniform(&rng, a, len, -1, 1);
+    tcb_batchnorm_forward_train(&L.bn, y, xh, st[0], st[1], st[2], x, n, 0);
+    tcb_batchnorm_forward_train(&L.bn, yr, xhr, str[0], str[1], str[2], x, n, 1);
+    int zeros = 0;
+    for (size_t i = 0; i < len; i++) {
+        assert_true(yr[i] == (y[i] > 0 ? y[i] : 0.0f));
+        zeros += yr[i] == 0.0f;
+        masked[i] = yr[i] > 0 ? a[i] : 0.0f;
+    }
+    assert_true(zeros > 0 && zeros < (int)len);
+    assert_memory_equal(xh, xhr, len * sizeof(float));
+    assert_memory_equal(st, str, sizeof st);
+    float *ye = falloc(len), *yer = falloc(len);
+    tcb_batchnorm_forward_eval(&L.bn, ye, x, n, 0);
+    tcb_batchnorm_forward_eval(&L.bn, yer, x, n, 1);
+    for (size_t i = 0; i < len; i++) assert_true(yer[i] == (ye[i] > 0 ? ye[i] : 0.0f));
+    free(ye), free(yer);
+    float g1[2 * C], g2[2 * C];
+    memset(L.grads, 0, sizeof L.grads);
+    tcb_batchnorm_backward(&L.bn, &L.g, dx, masked, NULL, xh, st[0], n);
+    memcpy(g1, L.grads, sizeof g1);
+    memset(L.grads, 0, sizeof L.grads);
+    tcb_batchnorm_backward(&L.bn, &L.g, dxr, a, yr, xh, st[0], n);
+    memcpy(g2, L.grads, sizeof g2);
+    assert_memory_equal(dx, dxr, len * sizeof(float));
+    assert_memory_equal(g1, g2, sizeof g1);
+    free(x), free(a), free(y), free(yr), free(xh), free(xhr), free(dx), free(dxr), free(masked);
 }
 
 /* n·C = 300·200 = 60,000 > 32,768: the OpenMP path runs (4 column chunks,
@@ -324,11 +370,11 @@ static void test_threads(void **state)
         for (int k = 0; k < 4; k++) out[t][k] = falloc(len);
         memcpy(L.buffers, b0, sizeof b0);
         memset(L.grads, 0, sizeof L.grads);
-        tcb_batchnorm_forward_train(&L.bn, out[t][0], out[t][1], st[t][0], st[t][1], st[t][2], x, n);
+        tcb_batchnorm_forward_train(&L.bn, out[t][0], out[t][1], st[t][0], st[t][1], st[t][2], x, n, 0);
         tcb_batchnorm_update_running(&L.bn, st[t][1], st[t][2], n);
-        tcb_batchnorm_forward_eval(&L.bn, out[t][2], x, n);
+        tcb_batchnorm_forward_eval(&L.bn, out[t][2], x, n, 0);
         memcpy(out[t][3], a, len * sizeof(float));
-        tcb_batchnorm_backward(&L.bn, &L.g, out[t][3], out[t][3], out[t][1], st[t][0], n);
+        tcb_batchnorm_backward(&L.bn, &L.g, out[t][3], out[t][3], NULL, out[t][1], st[t][0], n);
         memcpy(bufs[t], L.buffers, sizeof bufs[t]);
         memcpy(grads[t], L.grads, sizeof grads[t]);
     }
@@ -355,6 +401,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_layer),
         cmocka_unit_test(test_offset_input),
+        cmocka_unit_test(test_fused_relu),
         cmocka_unit_test(test_threads),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1,0 +1,316 @@
+/* cc: unsupervised cycle-consistent deformation (Groueix et al., SGP'19),
+ * the network of net.h trained by train.h on triplets of one sequence's
+ * frames (params `sampling` = random | knn | neighbors).
+ *
+ * Presets (overridable key by key; the default is cpu):
+ *   paper  C 1024, Z 512, H 64, L 6, 16 triplets of the dataset's input
+ *          points (the CC code's network and batch)
+ *   cpu    C 256, Z 128, H 32, L 6, 8 triplets of 1000 points (sized for
+ *          2 CPU cores: one cat-sized sequence in ≤ 30 min)
+ *   tiny   C 16, Z 8, H 8, L 2, 2 triplets of 200 points (tests)
+ * Iterations per preset and how they were chosen: docs/protocol.md.
+ *
+ * Read-out (transfer i → j): the GT vertices of i, in i's frame box, are
+ * deformed by the network conditioned on (z_i, z_j) with the running
+ * batch-norm statistics (PyTorch's eval()), and mapped back through j's
+ * box; the harness projects them onto j's GT vertices. This is the "push"
+ * direction the per-source-vertex metrics need (CC's own read-out pulls:
+ * each target point to its nearest deformed source point). The encoders
+ * see fresh input clouds of i and j from the pair's stream (readout
+ * "clouds", as every method), or the full vertex sets (readout
+ * "vertices", as CC's mesh inference). CC reconstructs no surface: no
+ * reconstruct, "-" in CD columns.
+ *
+ * Checkpoints: the whole training state every `checkpoint_every`
+ * iterations in <work_dir>/train.ckpt (train_ckpt.h), continued
+ * bit-identically by a killed run; after fit the harness saves the weights
+ * and running statistics through save/load below. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "methods/builtin.h"
+#include "methods/cycle/train.h"
+#include "methods/cycle/train_ckpt.h"
+#include "methods/params.h"
+#include "neural/train_loop.h"
+#include "neural/weights.h"
+#include "tcb/json.h"
+
+typedef struct cc_preset {
+    tcb_cc_dims d;
+    int batch, points;
+    long long iterations;
+} cc_preset;
+
+static const cc_preset presets[] = {
+    {{1024, 512, 64, 6}, 16, 0, 100000},
+    {{256, 128, 32, 6}, 8, 1000, 8000},
+    {{16, 8, 8, 2}, 2, 200, 60},
+};
+static const char *const preset_names[] = {"paper", "cpu", "tiny", NULL}; /* presets[k]; default cpu */
+static const char *const sampling_names[] = {"random", "knn", "neighbors", NULL}; /* tcb_cc_sampling */
+static const char *const readout_names[] = {"clouds", "vertices", NULL};
+
+typedef struct cc_method {
+    tcb_cc_dims d;
+    tcb_cc_train_cfg cfg;
+    int points;                 /* per training cloud; 0: the dataset's input_points */
+    double warmup;              /* fraction of the iterations with the self-reconstruction term */
+    int readout_vertices;
+    long long checkpoint_every;
+    uint64_t seed;              /* of the fit */
+    tcb_cc_net *net;            /* NULL before fit or load */
+    tcb_cc_frame_box *boxes;    /* [n_frames] of the fitted sequence */
+    int n_frames;
+} cc_method;
+
+static int parse_numbers(const cJSON *j, const char *where, const cc_preset *pr, cc_method *c, tcb_error *err)
+{
+    long long it, C, Z, H, L, batch, points, delta, knn;
+    tcb_cc_train_cfg *t = &c->cfg;
+    double def_warmup = t->sampler.sampling == TCB_CC_SAMPLE_RANDOM ? 30.0 / 1500 : 30.0 / 500;
+    int rc = tcb_json_int(j, "iterations", where, 0, pr->iterations, 1, 100000000, &it, err);
+    if (!rc) rc = tcb_json_int(j, "encoder_width", where, 0, pr->d.C, 1, 65536, &C, err);
+    if (!rc) rc = tcb_json_int(j, "latent", where, 0, pr->d.Z, 2, 65536, &Z, err);
+    if (!rc) rc = tcb_json_int(j, "hidden", where, 0, pr->d.H, 1, 4096, &H, err);
+    if (!rc) rc = tcb_json_int(j, "layers", where, 0, pr->d.L, 1, TCB_CC_MAX_META - 1, &L, err);
+    if (!rc) rc = tcb_json_int(j, "batch", where, 0, pr->batch, 2, TCB_CC_MAX_BATCH, &batch, err);
+    if (!rc) rc = tcb_json_int(j, "points", where, 0, pr->points, 0, 10000000, &points, err);
+    if (!rc) rc = tcb_json_num(j, "warmup", where, 0, def_warmup, 0, 1, &c->warmup, err);
+    if (!rc) rc = tcb_json_num(j, "lr", where, 0, 1e-3, 1e-12, 10, &t->lr, err);
+    if (!rc) rc = tcb_json_int(j, "delta", where, 0, 1, 1, 1000000, &delta, err);
+    if (!rc) rc = tcb_json_int(j, "knn", where, 0, TCB_CC_KNN_K, 1, 100000, &knn, err);
+    if (!rc) rc = tcb_json_int(j, "checkpoint_every", where, 0, 500, 0, 100000000, &c->checkpoint_every, err);
+    if (!rc) rc = tcb_json_num(j, "divergence", where, 0, 1e4, 0, 1e300, &t->divergence, err);
+    if (rc) return rc;
+    c->d = (tcb_cc_dims){(int)C, (int)Z, (int)H, (int)L};
+    t->batch = (int)batch, t->iterations = it, c->points = (int)points;
+    t->warmup = (long long)(c->warmup * (double)it + 0.5);
+    t->sampler.delta = (int)delta, t->sampler.knn_k = (int)knn;
+    return tcb_cc_dims_check(&c->d, where, err);
+}
+
+static int parse(const char *params_json, const char *where, cc_method *c, tcb_error *err)
+{
+    static const char *const keys[] = {"preset", "sampling", "readout", "iterations", "encoder_width", "latent",
+                                       "hidden", "layers", "batch", "points", "warmup", "lr", "delta", "knn",
+                                       "checkpoint_every", "divergence", NULL};
+    cJSON *j;
+    int rc = tcb_params_parse(params_json, where, keys, &j, err);
+    if (rc) return rc;
+    int pi = 1, si = 0, ri = 0;
+    c->cfg.sampler = tcb_cc_sampler_opts_default();
+    rc = tcb_json_enum(j, "preset", where, 0, 1, preset_names, &pi, err);
+    if (!rc) rc = tcb_json_enum(j, "sampling", where, 0, 0, sampling_names, &si, err);
+    if (!rc) rc = tcb_json_enum(j, "readout", where, 0, 0, readout_names, &ri, err);
+    c->cfg.sampler.sampling = (tcb_cc_sampling)si, c->readout_vertices = ri == 1;
+    if (!rc) rc = parse_numbers(j, where, &presets[pi], c, err);
+    cJSON_Delete(j);
+    return rc;
+}
+
+static int create(const char *params_json, void **self, tcb_error *err)
+{
+    *self = NULL;
+    cc_method *c = calloc(1, sizeof *c);
+    if (!c) return tcb_fail(err, TCB_ERR_NOMEM, "cc: out of memory");
+    int rc = parse(params_json, "cc.params", c, err);
+    if (rc) {
+        free(c);
+        return rc;
+    }
+    *self = c;
+    return TCB_OK;
+}
+
+static void destroy(void *self)
+{
+    cc_method *c = self;
+    if (!c) return;
+    tcb_cc_net_free(c->net);
+    free(c->boxes);
+    free(c);
+}
+
+/* A fresh network, initialised from (seed, "cc/init") when init, and the
+ * frame boxes of seq. */
+static int new_net(cc_method *c, const tcb_sequence *seq, uint64_t seed, int init, tcb_error *err)
+{
+    tcb_cc_net_free(c->net), free(c->boxes);
+    c->net = NULL, c->boxes = NULL, c->seed = seed, c->n_frames = seq->n_frames;
+    int rc = tcb_cc_net_create(&c->d, &c->net, err);
+    if (!rc && !(c->boxes = malloc((size_t)seq->n_frames * sizeof *c->boxes)))
+        rc = tcb_fail(err, TCB_ERR_NOMEM, "cc: out of memory");
+    for (int f = 0; !rc && f < seq->n_frames; f++) rc = tcb_cc_frame_box_compute(seq, f, &c->boxes[f], err);
+    if (!rc && init) {
+        tcb_rng rng;
+        tcb_rng_seed_stream(&rng, seed, "cc/init");
+        tcb_cc_net_init(c->net, &rng);
+    }
+    if (rc) tcb_cc_net_free(c->net), c->net = NULL;
+    return rc;
+}
+
+/* ---- fit ---- */
+
+/* The training loop's view of a cc training (neural/train_loop.h). */
+typedef struct cc_fit {
+    tcb_cc_trainer *t;
+    const tcb_sequence *seq;
+    uint64_t seed;
+} cc_fit;
+
+static int fit_step(void *f, double *loss, tcb_error *err)
+{
+    cc_fit *a = f;
+    return tcb_cc_train_step(a->t, a->seq, loss, err);
+}
+
+static long long fit_done(const void *f) { return ((const cc_fit *)f)->t->it; }
+
+static int fit_save(const void *f, double seconds, const char *path, tcb_error *err)
+{
+    const cc_fit *a = f;
+    return tcb_cc_train_ckpt_save(a->t, a->seq, a->seed, seconds, path, err);
+}
+
+static int fit_load(void *f, const char *path, double *seconds, tcb_error *err)
+{
+    cc_fit *a = f;
+    return tcb_cc_train_ckpt_load(a->t, a->seq, a->seed, path, seconds, err);
+}
+
+static int fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_error *err)
+{
+    cc_method *c = self;
+    /* training clouds of `points` points: a sequence view that differs only there */
+    tcb_sequence train_seq = *seq;
+    if (c->points > 0) train_seq.input_points = c->points;
+    cc_fit f = {.seq = &train_seq, .seed = ctx->seed};
+    int rc = new_net(c, seq, ctx->seed, 1, err);
+    if (!rc) rc = tcb_cc_trainer_create(&c->cfg, c->net, &train_seq, ctx->seed, &f.t, err);
+    if (rc) {
+        tcb_error_prefix(err, "cc: ");
+        return rc;
+    }
+    tcb_train_loop loop = {.name = "cc", .iterations = c->cfg.iterations, .checkpoint_every = c->checkpoint_every,
+                           .ckpt_name = TCB_CC_TRAIN_CKPT, .trainer = &f, .step = fit_step, .done = fit_done,
+                           .save = fit_save, .load = fit_load};
+    rc = tcb_train_loop_run(&loop, ctx, err);
+    tcb_cc_trainer_free(f.t);
+    return rc;
+}
+
+/* ---- transfer ---- */
+
+/* The code of encoder e for n points pts [n][3] (in their frame box), in
+ * evaluation mode, into z [Z]. */
+static int encode(const cc_method *c, int e, const float *pts, int n, float *z, tcb_error *err)
+{
+    tcb_cc_encoder_cache ec;
+    float *scratch = malloc(tcb_cc_encoder_scratch_floats(&c->d, 1, n) * sizeof(float));
+    int rc = scratch ? tcb_cc_encoder_cache_alloc(&ec, &c->d, 1, n, err)
+                     : tcb_fail(err, TCB_ERR_NOMEM, "cc: out of memory");
+    if (!rc) {
+        tcb_cc_encoder_forward(&c->net->p.enc[e], &ec, scratch, pts, 0);
+        memcpy(z, ec.z, (size_t)c->d.Z * sizeof(float));
+        tcb_cc_encoder_cache_free(&ec);
+    }
+    free(scratch);
+    return rc;
+}
+
+/* The encoders' input for frame f: a fresh cloud from rng, or the frame's
+ * vertices; in f's box. *pts is malloc'ed [*n][3]. */
+static int encoder_input(const cc_method *c, const tcb_sequence *seq, int f, tcb_rng *rng, float **pts, int *n,
+                         tcb_error *err)
+{
+    *n = c->readout_vertices ? seq->n_verts : seq->input_points;
+    if (!(*pts = malloc((size_t)*n * 3 * sizeof **pts))) return tcb_fail(err, TCB_ERR_NOMEM, "cc: out of memory");
+    int rc = TCB_OK;
+    if (c->readout_vertices) memcpy(*pts, tcb_seq_frame(seq, f), (size_t)*n * 3 * sizeof **pts);
+    else rc = tcb_sequence_draw_points(seq, f, *n, seq->draw_with_replacement, rng, *pts, err);
+    if (!rc) tcb_cc_frame_box_apply(&c->boxes[f], *pts, *n, *pts);
+    return rc;
+}
+
+static int deform(const cc_method *c, const float *zx, const float *zy, const float *x, int n, float *out,
+                  tcb_error *err)
+{
+    tcb_cc_deform_cache dc;
+    float *scratch = malloc(tcb_cc_deform_scratch_floats(c->net, 1, n) * sizeof(float));
+    int rc = scratch ? tcb_cc_deform_cache_alloc(&dc, c->net, 1, n, err)
+                     : tcb_fail(err, TCB_ERR_NOMEM, "cc: out of memory");
+    if (!rc) {
+        tcb_cc_deform_forward(c->net, &dc, scratch, zx, zy, x, 0);
+        memcpy(out, dc.out, (size_t)n * 3 * sizeof(float));
+        tcb_cc_deform_cache_free(&dc);
+    }
+    free(scratch);
+    return rc;
+}
+
+static int transfer(void *self, const tcb_sequence *seq, int i, int j, const float *src, int n, float *out,
+                    tcb_rng *rng, tcb_error *err)
+{
+    cc_method *c = self;
+    if (!c->net) return tcb_fail(err, TCB_ERR_INTERNAL, "cc: evaluation before fit or load");
+    if (i < 0 || j < 0 || i >= seq->n_frames || j >= seq->n_frames || seq->n_frames != c->n_frames)
+        return tcb_fail(err, TCB_ERR_INPUT, "cc: pair %d->%d outside frames 0..%d of the fitted sequence", i, j,
+                        c->n_frames - 1);
+    float *pi = NULL, *pj = NULL, *z = malloc(2 * (size_t)c->d.Z * sizeof *z);
+    int ni, nj, rc = z ? TCB_OK : tcb_fail(err, TCB_ERR_NOMEM, "cc: out of memory");
+    if (!rc) rc = encoder_input(c, seq, i, rng, &pi, &ni, err);
+    if (!rc) rc = encoder_input(c, seq, j, rng, &pj, &nj, err);
+    if (!rc) rc = encode(c, 0, pi, ni, z, err);
+    if (!rc) rc = encode(c, 1, pj, nj, z + c->d.Z, err);
+    if (!rc) {
+        tcb_cc_frame_box_apply(&c->boxes[i], src, n, out);
+        rc = deform(c, z, z + c->d.Z, out, n, out, err);
+    }
+    if (!rc) tcb_cc_frame_box_invert(&c->boxes[j], out, n, out);
+    free(pi), free(pj), free(z);
+    return rc;
+}
+
+/* ---- checkpoint: one model file (neural/weights.h), magic "TCBCCMD1" ---- */
+#define MAGIC "TCBCCMD1"
+
+static int save(void *self, const char *path, tcb_error *err)
+{
+    cc_method *c = self;
+    if (!c->net) return tcb_fail(err, TCB_ERR_INTERNAL, "%s: cc saved before fit", path);
+    cJSON *manifest = tcb_cc_net_manifest(c->net);
+    tcb_weight_parts w = tcb_cc_net_weights(c->net);
+    int rc = tcb_model_file_write(path, MAGIC, c->seed, manifest, &w, err);
+    cJSON_Delete(manifest);
+    return rc;
+}
+
+static int load(void *self, const tcb_sequence *seq, const char *path, tcb_error *err)
+{
+    cc_method *c = self;
+    uint64_t seed = 0;
+    int rc = new_net(c, seq, 0, 0, err);
+    if (rc) return rc;
+    cJSON *want = tcb_cc_net_manifest(c->net);
+    tcb_weight_parts w = tcb_cc_net_weights(c->net);
+    rc = tcb_model_file_read(path, MAGIC, want, &seed, &w, err);
+    cJSON_Delete(want);
+    if (rc) tcb_cc_net_free(c->net), c->net = NULL;
+    else c->seed = seed;
+    return rc;
+}
+
+const tcb_method_ops tcb_method_cc = {
+    .abi_version = TCB_METHOD_ABI_VERSION,
+    .name = "cc",
+    .description = "CC: unsupervised cycle-consistent deformation (meta-MLP conditioned on both shapes), "
+                   "triplet sampling random | knn | neighbors",
+    .create = create,
+    .fit = fit,
+    .transfer = transfer,
+    .save = save,
+    .load = load,
+    .destroy = destroy,
+};
