@@ -17,8 +17,8 @@
 static const char *const STATUS_NAMES[] = {"ok", "failed", "diverged", NULL};
 static const char *const TOP_KEYS[] = {"format", "tolerances", "rows", NULL};
 static const char *const TOL_KEYS[] = {"abs", "rel", NULL};
-static const char *const ROW_KEYS[] = {"dataset", "sequence", "method", "sl2", "rank",
-                                       "auc",     "cd",       "status", NULL};
+static const char *const ROW_KEYS[] = {"dataset", "sequence", "method", "sl2",        "rank",
+                                       "auc",     "cd",       "status", "tolerances", NULL};
 
 /* ----------------------------------------------------------------- write */
 
@@ -79,26 +79,36 @@ int tcb_baseline_write(const char *run_dir, const char *baseline_path, tcb_error
 
 /* ------------------------------------------------------------------ load */
 
-static int load_tolerances(const cJSON *root, const char *path, tcb_baseline *b, tcb_error *err)
+/* The tolerances object t ({metric: {"abs", "rel"}}) into abs_tol, rel_tol;
+ * with `every`, each metric must be there (the top level), else a metric
+ * left out keeps its value (a row's own tolerances). */
+static int parse_tolerances(const cJSON *t, const char *where, int every, double *abs_tol, double *rel_tol,
+                            tcb_error *err)
 {
-    char where[TCB_ERRMSG_MAX - 16]; /* room for ".<metric>" in sub */
-    snprintf(where, sizeof where, "%s: tolerances", path);
-    const cJSON *t = cJSON_GetObjectItemCaseSensitive(root, "tolerances");
     const char *keys[TCB_N_METRICS + 1] = {NULL};
     for (int m = 0; m < TCB_N_METRICS; m++) keys[m] = tcb_rpt_metrics[m].key;
-    if (!t) return tcb_fail(err, TCB_ERR_INPUT, "%s: required key is missing", where);
     int rc = tcb_json_expect_keys(t, where, keys, err);
     for (int m = 0; m < TCB_N_METRICS && !rc; m++) {
         char sub[TCB_ERRMSG_MAX];
         snprintf(sub, sizeof sub, "%s.%s", where, keys[m]);
         const cJSON *o = cJSON_GetObjectItemCaseSensitive(t, keys[m]);
+        if (!o && !every) continue;
         if (!o) return tcb_fail(err, TCB_ERR_INPUT, "%s: required key is missing", sub);
         if ((rc = tcb_json_expect_keys(o, sub, TOL_KEYS, err)) ||
-            (rc = tcb_json_num(o, "abs", sub, 1, 0, 0, INFINITY, &b->abs_tol[m], err)))
+            (rc = tcb_json_num(o, "abs", sub, 1, 0, 0, INFINITY, &abs_tol[m], err)))
             return rc;
-        rc = tcb_json_num(o, "rel", sub, 1, 0, 0, INFINITY, &b->rel_tol[m], err);
+        rc = tcb_json_num(o, "rel", sub, 1, 0, 0, INFINITY, &rel_tol[m], err);
     }
     return rc;
+}
+
+static int load_tolerances(const cJSON *root, const char *path, tcb_baseline *b, tcb_error *err)
+{
+    char where[TCB_ERRMSG_MAX - 16]; /* room for ".<metric>" in sub */
+    snprintf(where, sizeof where, "%s: tolerances", path);
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(root, "tolerances");
+    if (!t) return tcb_fail(err, TCB_ERR_INPUT, "%s: required key is missing", where);
+    return parse_tolerances(t, where, 1, b->abs_tol, b->rel_tol, err);
 }
 
 static int copy_name(const cJSON *o, const char *key, const char *where, char *dst, size_t size,
@@ -114,9 +124,12 @@ static int copy_name(const cJSON *o, const char *key, const char *where, char *d
     return TCB_OK;
 }
 
-static int load_row(const cJSON *o, const char *where, tcb_baseline_row *r, tcb_error *err)
+/* A row; its tolerances start as the file's (b) and may be its own. */
+static int load_row(const cJSON *o, const char *where, const tcb_baseline *b, tcb_baseline_row *r, tcb_error *err)
 {
     int st, rc;
+    memcpy(r->abs_tol, b->abs_tol, sizeof r->abs_tol);
+    memcpy(r->rel_tol, b->rel_tol, sizeof r->rel_tol);
     if ((rc = tcb_json_expect_keys(o, where, ROW_KEYS, err)) ||
         (rc = copy_name(o, "dataset", where, r->dataset, sizeof r->dataset, err)) ||
         (rc = copy_name(o, "sequence", where, r->sequence, sizeof r->sequence, err)) ||
@@ -133,7 +146,11 @@ static int load_row(const cJSON *o, const char *where, tcb_baseline_row *r, tcb_
         r->has[m] = cJSON_IsNumber(v);
         r->value[m] = r->has[m] ? v->valuedouble : NAN;
     }
-    return TCB_OK;
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "tolerances");
+    if (!t) return TCB_OK;
+    char sub[TCB_ERRMSG_MAX - 32]; /* room for ".<metric>" after it */
+    snprintf(sub, sizeof sub, "%s.tolerances", where);
+    return parse_tolerances(t, sub, 0, r->abs_tol, r->rel_tol, err);
 }
 
 static int same_key(const tcb_baseline_row *a, const tcb_baseline_row *b)
@@ -151,10 +168,10 @@ static int load_rows(const cJSON *root, const char *path, tcb_baseline *b, tcb_e
     b->rows = calloc(n ? (size_t)n : 1, sizeof *b->rows);
     if (!b->rows) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", path);
     for (const cJSON *o = rows->child; o; o = o->next) {
-        char where[TCB_ERRMSG_MAX];
+        char where[TCB_ERRMSG_MAX - 64]; /* room for ".tolerances.<metric>" after it */
         snprintf(where, sizeof where, "%s: rows[%d]", path, b->n_rows);
         tcb_baseline_row *r = &b->rows[b->n_rows];
-        int rc = load_row(o, where, r, err);
+        int rc = load_row(o, where, b, r, err);
         if (rc) return rc;
         for (int k = 0; k < b->n_rows; k++)
             if (same_key(&b->rows[k], r))

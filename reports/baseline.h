@@ -4,9 +4,13 @@
  *     "tolerances": { "sl2": {"abs", "rel"}, "rank": …, "auc": …, "cd": … },
  *     "rows": [ { "dataset", "sequence", "method",
  *                 "sl2", "rank", "auc", "cd",        table units; null = none
- *                 "status" } ] }                     optional, "ok" by default
+ *                 "status",                          optional, "ok" by default
+ *                 "tolerances" } ] }                 optional: the row's own, for
+ *                                                    any of the metrics
  * A value passes when |current − baseline| ≤ abs + rel·|baseline|. Rows of
- * failed or diverged methods carry their status and null values. */
+ * failed or diverged methods carry their status and null values. A row's
+ * own tolerances (kept by hand: an --update writes the defaults) serve a
+ * trained method whose last digits follow the CPU's BLAS kernels. */
 #ifndef TCB_REPORTS_BASELINE_H
 #define TCB_REPORTS_BASELINE_H
 
@@ -21,6 +25,7 @@ typedef struct tcb_baseline_row {
     char status[16];             /* "ok" | "failed" | "diverged" */
     int has[TCB_N_METRICS];      /* 0: null */
     double value[TCB_N_METRICS]; /* table units */
+    double abs_tol[TCB_N_METRICS], rel_tol[TCB_N_METRICS]; /* the file's, or the row's own */
 } tcb_baseline_row;
 
 typedef struct tcb_baseline {

@@ -24,8 +24,8 @@ static void line(const diff_table *t, const char *row, const char *metric, const
 static const char *verdict(int ok) { return ok ? "OK" : "DRIFT"; }
 
 /* One metric; returns 1 when within tolerance. */
-static int check_value(const diff_table *t, const char *row, int m, const tcb_baseline *b,
-                       const tcb_baseline_row *br, const tcb_rpt_row *cr)
+static int check_value(const diff_table *t, const char *row, int m, const tcb_baseline_row *br,
+                       const tcb_rpt_row *cr)
 {
     char base[32] = "-", cur[32] = "-", delta[32] = "", tol[32] = "";
     if (br->has[m]) snprintf(base, sizeof base, "%.6f", br->value[m]);
@@ -33,7 +33,7 @@ static int check_value(const diff_table *t, const char *row, int m, const tcb_ba
     int ok = br->has[m] == cr->has[m];
     if (br->has[m] && cr->has[m]) {
         double d = cr->mean[m] - br->value[m];
-        double limit = b->abs_tol[m] + b->rel_tol[m] * fabs(br->value[m]);
+        double limit = br->abs_tol[m] + br->rel_tol[m] * fabs(br->value[m]);
         snprintf(delta, sizeof delta, "%+.3e", d);
         snprintf(tol, sizeof tol, "%.1e", limit);
         ok = fabs(d) <= limit; /* false for NaN */
@@ -43,8 +43,7 @@ static int check_value(const diff_table *t, const char *row, int m, const tcb_ba
 }
 
 /* One row present on both sides; returns 1 when it passes. */
-static int check_row(const diff_table *t, const tcb_baseline *b, const tcb_baseline_row *br,
-                     const tcb_rpt_row *cr)
+static int check_row(const diff_table *t, const tcb_baseline_row *br, const tcb_rpt_row *cr)
 {
     char row[320];
     snprintf(row, sizeof row, "%s/%s/%s", br->dataset, br->sequence, br->method);
@@ -54,7 +53,7 @@ static int check_row(const diff_table *t, const tcb_baseline *b, const tcb_basel
         return ok;
     }
     int ok = 1;
-    for (int m = 0; m < TCB_N_METRICS; m++) ok &= check_value(t, row, m, b, br, cr);
+    for (int m = 0; m < TCB_N_METRICS; m++) ok &= check_value(t, row, m, br, cr);
     return ok;
 }
 
@@ -108,7 +107,7 @@ static int compare(const tcb_rpt *r, const tcb_baseline *b, FILE *out, int *n_dr
             continue;
         }
         seen[flat] = 1;
-        *n_drift += !check_row(&t, b, br, cr);
+        *n_drift += !check_row(&t, br, cr);
     }
     int flat = 0;
     for (int k = 0; k < r->n_blocks; k++)

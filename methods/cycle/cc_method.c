@@ -7,6 +7,9 @@
  *          points (the CC code's network and batch)
  *   cpu    C 256, Z 128, H 32, L 6, 8 triplets of 1000 points (sized for
  *          2 CPU cores: one cat-sized sequence in ≤ 30 min)
+ *   short  C 64, Z 32, H 16, L 6, 4 triplets of 500 points, 400
+ *          iterations (the default benchmark's: a first report with the
+ *          fifth method in it, seconds per sequence; far from trained)
  *   tiny   C 16, Z 8, H 8, L 2, 2 triplets of 200 points (tests)
  * Iterations per preset and how they were chosen: docs/protocol.md.
  *
@@ -43,11 +46,12 @@ typedef struct cc_preset {
 } cc_preset;
 
 static const cc_preset presets[] = {
-    {{1024, 512, 64, 6}, 16, 0, 100000},
-    {{256, 128, 32, 6}, 8, 1000, 8000},
+    {{1024, 512, 64, 6}, 16, 0, 75000},
+    {{256, 128, 32, 6}, 8, 1000, 4800},
+    {{64, 32, 16, 6}, 4, 500, 400},
     {{16, 8, 8, 2}, 2, 200, 60},
 };
-static const char *const preset_names[] = {"paper", "cpu", "tiny", NULL}; /* presets[k]; default cpu */
+static const char *const preset_names[] = {"paper", "cpu", "short", "tiny", NULL}; /* presets[k]; default cpu */
 static const char *const sampling_names[] = {"random", "knn", "neighbors", NULL}; /* tcb_cc_sampling */
 static const char *const readout_names[] = {"clouds", "vertices", NULL};
 

@@ -174,6 +174,46 @@ static void status_changes(cJSON *root, cJSON *row)
     cJSON_ReplaceItemInObject(row, "status", cJSON_CreateString("failed"));
 }
 
+/* A row's own tolerances: sl2 ±2e-3 on horse/AN alone. A 1e-3 shift
+ * passes there, while the same shift of another row still drifts; a
+ * malformed row tolerance is refused naming its key. */
+static void own_tolerance(cJSON *root, cJSON *row)
+{
+    (void)root;
+    cJSON *t = cJSON_AddObjectToObject(row, "tolerances"), *m = cJSON_AddObjectToObject(t, "sl2");
+    cJSON_AddNumberToObject(m, "abs", 2e-3), cJSON_AddNumberToObject(m, "rel", 0);
+    shift(row, 1e-3);
+}
+static void own_tolerance_bad(cJSON *root, cJSON *row)
+{
+    (void)root;
+    cJSON *t = cJSON_AddObjectToObject(row, "tolerances"), *m = cJSON_AddObjectToObject(t, "sl2");
+    cJSON_AddNumberToObject(m, "abs", -1), cJSON_AddNumberToObject(m, "rel", 0);
+}
+
+static void test_row_tolerance(void **state)
+{
+    fixture *f = *state;
+    char path[2048], *table, lines[8][256];
+    edited(f, "horse", "AN", own_tolerance, "own.json", path, sizeof path);
+    assert_int_equal(check(f, path, &table), 0);
+    assert_non_null(strstr(table, "2.0e-03"));
+    free(table);
+    edited(f, "cat", "AN", own_tolerance, "own_cat.json", path, sizeof path);
+    assert_int_equal(check(f, path, &table), 0);
+    free(table);
+    edited(f, "horse", "AN", beyond_tolerance, "beyond2.json", path, sizeof path);
+    assert_int_equal(check(f, path, &table), 1);
+    assert_int_equal(drift_lines(table, lines, 8), 1);
+    free(table);
+    edited(f, "horse", "AN", own_tolerance_bad, "own_bad.json", path, sizeof path);
+    int n_drift = -1;
+    tcb_error err = {0};
+    assert_int_equal(tcb_check(f->dir, path, NULL, &n_drift, &err), TCB_ERR_INPUT);
+    if (!strstr(err.msg, "tolerances.sl2.abs") || !strstr(err.msg, "rows["))
+        fail_msg("message: %s", err.msg);
+}
+
 static void test_null_and_status_mismatch_drift(void **state)
 {
     fixture *f = *state;
@@ -272,6 +312,7 @@ int main(void)
         cmocka_unit_test(test_baseline_checks_clean),
         cmocka_unit_test(test_drift_beyond_tolerance),
         cmocka_unit_test(test_relative_tolerance),
+        cmocka_unit_test(test_row_tolerance),
         cmocka_unit_test(test_null_and_status_mismatch_drift),
         cmocka_unit_test(test_missing_and_extra_rows_drift),
         cmocka_unit_test(test_malformed_baselines),
