@@ -7,7 +7,7 @@
  *          points (the CC code's network and batch)
  *   cpu    C 256, Z 128, H 32, L 6, 8 triplets of 1000 points (sized for
  *          2 CPU cores: one cat-sized sequence in ≤ 30 min)
- *   short  C 64, Z 32, H 16, L 6, 4 triplets of 500 points, 400
+ *   short  C 32, Z 16, H 16, L 4, 4 triplets of 300 points, 300
  *          iterations (the default benchmark's: a first report with the
  *          fifth method in it, seconds per sequence; far from trained)
  *   tiny   C 16, Z 8, H 8, L 2, 2 triplets of 200 points (tests)
@@ -48,7 +48,7 @@ typedef struct cc_preset {
 static const cc_preset presets[] = {
     {{1024, 512, 64, 6}, 16, 0, 75000},
     {{256, 128, 32, 6}, 8, 1000, 4800},
-    {{64, 32, 16, 6}, 4, 500, 400},
+    {{32, 16, 16, 4}, 4, 300, 300},
     {{16, 8, 8, 2}, 2, 200, 60},
 };
 static const char *const preset_names[] = {"paper", "cpu", "short", "tiny", NULL}; /* presets[k]; default cpu */

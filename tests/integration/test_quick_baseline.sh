@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
 # The default benchmark (configs/quick.json) reproduces the committed
 # regression baseline: `tcbench check` exits 0, and oracle is perfect. The
-# cc rows (a 400-iteration training) carry their own tolerances in the
-# baseline: on one machine they repeat bit for bit, on another CPU the BLAS
-# kernels round differently and the training amplifies it.
+# cc rows (a 300-iteration training, far from converged) carry their own,
+# wide tolerances in the baseline: a build repeats them bit for bit at a
+# given thread count, but another build or CPU rounds a few operations
+# differently (vectorized reductions, BLAS kernels) and the training
+# amplifies it (the sanitized build's m_sL2 is 8-36 % off the Release
+# build's), so for cc this is a smoke check that training and read-out
+# work, not a regression check of its numbers.
 set -euo pipefail
 : "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
 
@@ -24,6 +28,8 @@ for c in cells:
     assert s["n_pairs"] == 500
     if c["method"] == "oracle":
         assert s["sl2"]["mean"] == 0 and s["rank"]["mean"] == 0 and s["auc"]["mean"] == 1, s
+    elif c["method"] == "cc":
+        assert c["timings"]["fit_s"] > 0 and s["cd"] is None, c
     else:
         assert s["sl2"]["mean"] > 0 and s["auc"]["mean"] < 1, s
 print("quick config: %d cells ok" % len(cells))
