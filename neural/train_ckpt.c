@@ -136,21 +136,27 @@ int tcb_train_ckpt_read(const char *path, const char magic[8], const char *what,
     return rc;
 }
 
-int tcb_trainer_state_save(const char *path, const char magic[8], const tcb_ckpt_settings *s,
-                           const tcb_trainer_state *st, double seconds, const tcb_ckpt_array *arrays,
-                           int n_arrays, tcb_error *err)
+static tcb_ckpt_settings settings_of(const tcb_ckpt_spec *s)
 {
-    tcb_train_progress p = {.it = *st->it, .adam_t = st->adam->t, .loss0 = *st->loss0, .seconds = seconds};
-    memcpy(p.rng, st->rng->s, sizeof p.rng);
-    return tcb_train_ckpt_write(path, magic, s, &p, arrays, n_arrays, err);
+    return (tcb_ckpt_settings){.n_ints = s->n_ints, .n_reals = s->n_reals, .int_names = s->int_names,
+                               .real_names = s->real_names, .ints = s->ints, .reals = s->reals, .seed = s->seed};
 }
 
-int tcb_trainer_state_load(const char *path, const char magic[8], const char *what,
-                           const tcb_ckpt_settings *want, int64_t max_it, const tcb_trainer_state *st,
-                           double *seconds, const tcb_ckpt_array *arrays, int n_arrays, tcb_error *err)
+int tcb_ckpt_spec_save(const tcb_ckpt_spec *s, double seconds, const char *path, tcb_error *err)
 {
+    const tcb_trainer_state *st = &s->state;
+    tcb_ckpt_settings set = settings_of(s);
+    tcb_train_progress p = {.it = *st->it, .adam_t = st->adam->t, .loss0 = *st->loss0, .seconds = seconds};
+    memcpy(p.rng, st->rng->s, sizeof p.rng);
+    return tcb_train_ckpt_write(path, s->magic, &set, &p, s->arrays, s->n_arrays, err);
+}
+
+int tcb_ckpt_spec_load(const tcb_ckpt_spec *s, const char *path, double *seconds, tcb_error *err)
+{
+    const tcb_trainer_state *st = &s->state;
+    tcb_ckpt_settings want = settings_of(s);
     tcb_train_progress p;
-    int rc = tcb_train_ckpt_read(path, magic, what, want, max_it, &p, arrays, n_arrays, err);
+    int rc = tcb_train_ckpt_read(path, s->magic, s->what, &want, s->max_it, &p, s->arrays, s->n_arrays, err);
     if (rc) return rc;
     memcpy(st->rng->s, p.rng, sizeof p.rng);
     *st->it = p.it, st->adam->t = p.adam_t, *st->loss0 = p.loss0;

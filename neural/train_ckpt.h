@@ -80,14 +80,32 @@ typedef struct tcb_trainer_state {
     double *loss0;
 } tcb_trainer_state;
 
-/* tcb_train_ckpt_write of st's progress with `seconds` of training. */
-int tcb_trainer_state_save(const char *path, const char magic[8], const tcb_ckpt_settings *s,
-                           const tcb_trainer_state *st, double seconds, const tcb_ckpt_array *arrays,
-                           int n_arrays, tcb_error *err);
+#define TCB_CKPT_MAX_INTS 32
+#define TCB_CKPT_MAX_REALS 8
+#define TCB_CKPT_MAX_ARRAYS 8
 
-/* tcb_train_ckpt_read into st (all or nothing), *seconds its time stamp. */
-int tcb_trainer_state_load(const char *path, const char magic[8], const char *what,
-                           const tcb_ckpt_settings *want, int64_t max_it, const tcb_trainer_state *st,
-                           double *seconds, const tcb_ckpt_array *arrays, int n_arrays, tcb_error *err);
+/* Everything a method's checkpoint is, filled by the method (its settings'
+ * values and names, its arrays, where its trainer keeps its progress), so
+ * that saving and loading are one call each. */
+typedef struct tcb_ckpt_spec {
+    const char *magic;             /* 8 characters, e.g. "TCBATRN2" */
+    const char *what;              /* for the bad-magic message: "an atlas training checkpoint" */
+    int n_ints, n_reals, n_arrays;
+    const char *const *int_names;  /* [n_ints] */
+    const char *const *real_names; /* [n_reals] */
+    int64_t ints[TCB_CKPT_MAX_INTS];
+    double reals[TCB_CKPT_MAX_REALS];
+    uint64_t seed;
+    int64_t max_it;                /* the training's last iteration */
+    tcb_ckpt_array arrays[TCB_CKPT_MAX_ARRAYS];
+    tcb_trainer_state state;
+} tcb_ckpt_spec;
+
+/* tcb_train_ckpt_write of the spec's progress with `seconds` of training. */
+int tcb_ckpt_spec_save(const tcb_ckpt_spec *s, double seconds, const char *path, tcb_error *err);
+
+/* tcb_train_ckpt_read into the spec's arrays and progress (all or
+ * nothing), *seconds its time stamp. */
+int tcb_ckpt_spec_load(const tcb_ckpt_spec *s, const char *path, double *seconds, tcb_error *err);
 
 #endif

@@ -1,6 +1,8 @@
 #define _XOPEN_SOURCE 700 /* nftw */
 #include "testutil.h"
 
+#include "tcb/rng.h"
+
 #include <ftw.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -59,4 +61,30 @@ const char *tu_shared_data(void)
 {
     struct stat st;
     return stat(TCB_SHARED_DATA, &st) == 0 && S_ISDIR(st.st_mode) ? TCB_SHARED_DATA : NULL;
+}
+
+static void *zeroed(size_t n, size_t size)
+{
+    void *p = calloc(n ? n : 1, size);
+    if (!p) {
+        fprintf(stderr, "out of memory (%zu × %zu bytes)\n", n, size);
+        abort();
+    }
+    return p;
+}
+
+float *tu_falloc(size_t n) { return zeroed(n, sizeof(float)); }
+
+double *tu_dalloc(size_t n) { return zeroed(n, sizeof(double)); }
+
+double *tu_to_double(const float *x, size_t n)
+{
+    double *d = tu_dalloc(n);
+    for (size_t i = 0; i < n; i++) d[i] = x[i];
+    return d;
+}
+
+void tu_fill_uniform(tcb_rng *r, float *x, size_t n, double lo, double hi)
+{
+    for (size_t i = 0; i < n; i++) x[i] = (float)(lo + (hi - lo) * tcb_rng_uniform(r));
 }

@@ -31,4 +31,16 @@ void tu_remove_tree(const char *dir);
 /* Path of the shared real data (../shared/data), or NULL when absent. */
 const char *tu_shared_data(void);
 
+/* Zeroed arrays of n floats / doubles (at least one element); abort on
+ * out of memory. */
+float *tu_falloc(size_t n);
+double *tu_dalloc(size_t n);
+
+/* A double copy of x[0..n). */
+double *tu_to_double(const float *x, size_t n);
+
+/* x[i] = U(lo, hi) from r, in order. */
+struct tcb_rng;
+void tu_fill_uniform(struct tcb_rng *r, float *x, size_t n, double lo, double hi);
+
 #endif

@@ -38,26 +38,6 @@ enum { C = 16, P = 2, B = 2, N = 32, M = 14, MP = M / P };
 
 /* ---------------------------------------------------------------- helpers */
 
-static void fill_uniform(tcb_rng *r, float *x, size_t n, double lo, double hi)
-{
-    for (size_t i = 0; i < n; i++) x[i] = (float)(lo + (hi - lo) * tcb_rng_uniform(r));
-}
-
-static float *falloc(size_t n)
-{
-    float *p = calloc(n ? n : 1, sizeof(float));
-    assert_non_null(p);
-    return p;
-}
-
-static double *to_double(const float *x, size_t n)
-{
-    double *d = malloc((n ? n : 1) * sizeof(double));
-    assert_non_null(d);
-    for (size_t i = 0; i < n; i++) d[i] = x[i];
-    return d;
-}
-
 static void check_forward(const char *what, const float *got, const double *want, size_t n)
 {
     double scale = 0.0;
@@ -199,15 +179,15 @@ static double lin_objective(void *p)
 static void check_linear(int n, int in, int out, tcb_rng *rng)
 {
     int rows = 3 * n;
-    float *x = falloc((size_t)rows * in), *W = falloc((size_t)out * in), *b = falloc(out);
-    float *y = falloc((size_t)rows * out), *w = falloc((size_t)rows * out);
-    float *dx = falloc((size_t)rows * in), *dW = falloc((size_t)out * in), *db = falloc(out);
-    fill_uniform(rng, x, (size_t)rows * in, -1, 1);
-    fill_uniform(rng, W, (size_t)out * in, -1, 1);
-    fill_uniform(rng, b, out, -1, 1);
-    fill_uniform(rng, w, (size_t)rows * out, -1, 1);
-    lin_ctx c = {to_double(x, (size_t)rows * in), to_double(W, (size_t)out * in),
-                 to_double(b, out), to_double(w, (size_t)rows * out), n, 2, in, out};
+    float *x = tu_falloc((size_t)rows * in), *W = tu_falloc((size_t)out * in), *b = tu_falloc(out);
+    float *y = tu_falloc((size_t)rows * out), *w = tu_falloc((size_t)rows * out);
+    float *dx = tu_falloc((size_t)rows * in), *dW = tu_falloc((size_t)out * in), *db = tu_falloc(out);
+    tu_fill_uniform(rng, x, (size_t)rows * in, -1, 1);
+    tu_fill_uniform(rng, W, (size_t)out * in, -1, 1);
+    tu_fill_uniform(rng, b, out, -1, 1);
+    tu_fill_uniform(rng, w, (size_t)rows * out, -1, 1);
+    lin_ctx c = {tu_to_double(x, (size_t)rows * in), tu_to_double(W, (size_t)out * in),
+                 tu_to_double(b, out), tu_to_double(w, (size_t)rows * out), n, 2, in, out};
 
     tcb_linear_forward(y, x, W, b, n, 2, in, out);
     double *yref = malloc((size_t)rows * out * sizeof(double));
@@ -263,10 +243,10 @@ static void test_relu(void **state)
     tcb_rng rng;
     tcb_rng_seed_stream(&rng, 1, "test/atlas/relu");
     float x[n], y[n], w[n], dx[n];
-    fill_uniform(&rng, x, n, -1, 1);
-    fill_uniform(&rng, w, n, -1, 1);
+    tu_fill_uniform(&rng, x, n, -1, 1);
+    tu_fill_uniform(&rng, w, n, -1, 1);
     tcb_relu_forward(y, x, n);
-    relu_ctx c = {to_double(x, n), to_double(w, n), n};
+    relu_ctx c = {tu_to_double(x, n), tu_to_double(w, n), n};
     for (int i = 0; i < n; i++) assert_true(y[i] == (x[i] > 0 ? x[i] : 0.0f));
     tcb_relu_backward(dx, w, y, n);
     check_grad("relu dx", relu_objective, &c, c.x, dx, n, n, &rng);
@@ -306,13 +286,13 @@ static void test_softplus(void **state)
     tcb_rng rng;
     tcb_rng_seed_stream(&rng, 1, "test/atlas/softplus");
     float x[len], y[len], w[len], dx[len];
-    fill_uniform(&rng, x, len, -4, 4);
-    fill_uniform(&rng, w, len, -1, 1);
+    tu_fill_uniform(&rng, x, len, -4, 4);
+    tu_fill_uniform(&rng, w, len, -1, 1);
     x[0] = 25.0f;  /* linear branch: softplus′ = 1, softplus′′ = 0 */
     x[1] = -30.0f; /* deep in the exponential tail */
     x[2] = 19.5f;  /* just below the threshold */
     tcb_softplus_forward(y, x, n, 2, d);
-    sp_ctx c = {to_double(x, len), to_double(w, len), n, d};
+    sp_ctx c = {tu_to_double(x, len), tu_to_double(w, len), n, d};
     double yref[len];
     ref_softplus_stack(c.x, yref, n, d);
     check_forward("softplus y", y, yref, len);
@@ -358,7 +338,7 @@ static void test_maxpool(void **state)
     tcb_rng_seed_stream(&rng, 1, "test/atlas/maxpool");
     float h[nb * n * out], y[nb * out];
     int32_t arg[nb * out];
-    fill_uniform(&rng, h, nb * n * out, -1, 1);
+    tu_fill_uniform(&rng, h, nb * n * out, -1, 1);
     h[4 * out] = h[7 * out] = 5.0f; /* a tie in set 0, channel 0: the first point wins */
     tcb_maxpool_forward(y, arg, h, nb, n, out);
     assert_int_equal(arg[0], 4);
@@ -372,15 +352,15 @@ static void test_maxpool(void **state)
     /* linear + pool backward against differences of the composed function */
     float x[nb * n * in], W[out * in], bias[out], w[nb * out];
     float dx[nb * n * in], dW[out * in] = {0}, db[out] = {0};
-    fill_uniform(&rng, x, nb * n * in, -1, 1);
-    fill_uniform(&rng, W, out * in, -1, 1);
-    fill_uniform(&rng, bias, out, -1, 1);
-    fill_uniform(&rng, w, nb * out, -1, 1);
+    tu_fill_uniform(&rng, x, nb * n * in, -1, 1);
+    tu_fill_uniform(&rng, W, out * in, -1, 1);
+    tu_fill_uniform(&rng, bias, out, -1, 1);
+    tu_fill_uniform(&rng, w, nb * out, -1, 1);
     tcb_linear_forward(h, x, W, bias, nb * n, 0, in, out);
     tcb_maxpool_forward(y, arg, h, nb, n, out);
     tcb_maxpool_linear_backward(dx, dW, db, w, arg, x, W, nb, n, in, out);
-    pool_ctx c = {to_double(x, nb * n * in), to_double(W, out * in), to_double(bias, out),
-                  to_double(w, nb * out), nb, n, in, out};
+    pool_ctx c = {tu_to_double(x, nb * n * in), tu_to_double(W, out * in), tu_to_double(bias, out),
+                  tu_to_double(w, nb * out), nb, n, in, out};
     check_grad("pooled linear dW", pool_objective, &c, c.W, dW, out * in, out * in, &rng);
     check_grad("pooled linear db", pool_objective, &c, c.b, db, out, out, &rng);
     check_grad("pooled linear dx", pool_objective, &c, c.x, dx, nb * n * in, nb * n * in, &rng);
@@ -436,9 +416,9 @@ static void dec_setup(dec_fixture *f, tcb_rng *rng)
     f->m = make_model(11);
     assert_int_equal(tcb_atlas_decoder_cache_alloc(&f->cache, B, MP, C, &err), TCB_OK);
     assert_int_equal(tcb_atlas_decoder_scratch_alloc(&f->scratch, B, MP, C, &err), TCB_OK);
-    fill_uniform(rng, f->z, B * C, 0, 2); /* latent codes come out of a ReLU */
-    fill_uniform(rng, f->uv, MP * 2, 0, 1);
-    fill_uniform(rng, f->coef, 3 * B * MP * 3, -1, 1);
+    tu_fill_uniform(rng, f->z, B * C, 0, 2); /* latent codes come out of a ReLU */
+    tu_fill_uniform(rng, f->uv, MP * 2, 0, 1);
+    tu_fill_uniform(rng, f->coef, 3 * B * MP * 3, -1, 1);
 }
 
 static void dec_teardown(dec_fixture *f)
@@ -458,7 +438,7 @@ static void test_decoder_tangents(void **state)
     dec_fixture f;
     dec_setup(&f, &rng);
     tcb_atlas_decoder_forward(&f.m->dec[0], &f.cache, f.z, f.uv, 2, f.out);
-    double *pd = to_double(f.m->params, f.m->nparams), *zd = to_double(f.z, B * C);
+    double *pd = tu_to_double(f.m->params, f.m->nparams), *zd = tu_to_double(f.z, B * C);
     double ref[3 * B * MP * 3], fd[2 * B * MP * 3];
     const double h = 1e-5;
     for (int b = 0; b < B; b++)
@@ -492,8 +472,8 @@ static void check_decoder_grad(int nt)
     float dz[B * C] = {0}, duv[MP * 2] = {0};
     tcb_atlas_decoder_backward(&f.m->dec[0], &f.m->gdec[0], &f.cache, &f.scratch, f.z, f.uv,
                                f.coef, nt, dz, duv);
-    dec_ctx c = {f.m, to_double(f.m->params, f.m->nparams), to_double(f.z, B * C),
-                 to_double(f.uv, MP * 2), to_double(f.coef, 3 * B * MP * 3)};
+    dec_ctx c = {f.m, tu_to_double(f.m->params, f.m->nparams), tu_to_double(f.z, B * C),
+                 tu_to_double(f.uv, MP * 2), tu_to_double(f.coef, 3 * B * MP * 3)};
     for (int k = 0; k < TCB_ATLAS_DEC_LAYERS; k++) {
         const tcb_linear *l = &f.m->dec[0].l[k], *g = &f.m->gdec[0].l[k];
         char what[64];
@@ -552,10 +532,10 @@ static void test_encoder_grad(void **state)
     tcb_error err = {0};
     assert_int_equal(tcb_atlas_encoder_cache_alloc(&cache, B, N, C, &err), TCB_OK);
     float clouds[B * N * 3], w[B * C];
-    fill_uniform(&rng, clouds, B * N * 3, -0.5, 0.5);
-    fill_uniform(&rng, w, B * C, -1, 1);
-    enc_ctx c = {m, to_double(m->params, m->nparams), to_double(clouds, B * N * 3),
-                 to_double(w, B * C)};
+    tu_fill_uniform(&rng, clouds, B * N * 3, -0.5, 0.5);
+    tu_fill_uniform(&rng, w, B * C, -1, 1);
+    enc_ctx c = {m, tu_to_double(m->params, m->nparams), tu_to_double(clouds, B * N * 3),
+                 tu_to_double(w, B * C)};
     tcb_atlas_encoder_forward(&m->enc, &cache, clouds);
     double zref[B * C];
     ref_encode(m, c.pd, c.clouds, B, N, zref);
@@ -610,15 +590,15 @@ static void test_model_grad(void **state)
     tcb_error err = {0};
     assert_int_equal(tcb_atlas_work_create(m, B, N, M, &w, &err), TCB_OK);
     float clouds[B * N * 3], uv[M * 2], out[3][B * M * 3], coef[3][B * M * 3];
-    fill_uniform(&rng, clouds, B * N * 3, -0.5, 0.5);
-    fill_uniform(&rng, uv, M * 2, 0, 1);
-    for (int k = 0; k < 3; k++) fill_uniform(&rng, coef[k], B * M * 3, -1, 1);
+    tu_fill_uniform(&rng, clouds, B * N * 3, -0.5, 0.5);
+    tu_fill_uniform(&rng, uv, M * 2, 0, 1);
+    for (int k = 0; k < 3; k++) tu_fill_uniform(&rng, coef[k], B * M * 3, -1, 1);
     tcb_atlas_model_forward(m, w, clouds, uv, out[0], out[1], out[2]);
 
-    model_ctx c = {m, to_double(m->params, m->nparams), to_double(clouds, B * N * 3),
-                   to_double(uv, M * 2),
-                   {to_double(coef[0], B * M * 3), to_double(coef[1], B * M * 3),
-                    to_double(coef[2], B * M * 3)}};
+    model_ctx c = {m, tu_to_double(m->params, m->nparams), tu_to_double(clouds, B * N * 3),
+                   tu_to_double(uv, M * 2),
+                   {tu_to_double(coef[0], B * M * 3), tu_to_double(coef[1], B * M * 3),
+                    tu_to_double(coef[2], B * M * 3)}};
     double z[B * C], ref[3][B * M * 3];
     ref_encode(m, c.pd, c.clouds, B, N, z);
     for (int b = 0; b < B; b++)

@@ -32,11 +32,6 @@ static tcb_atlas_model *make_model(int c, int p, uint64_t seed)
     return m;
 }
 
-static void fill_uniform(tcb_rng *r, float *x, size_t n, double lo, double hi)
-{
-    for (size_t i = 0; i < n; i++) x[i] = (float)(lo + (hi - lo) * tcb_rng_uniform(r));
-}
-
 /* reference-protocol §2.2: 2,239,872 encoder + 1,712,908 per patch. */
 static void test_param_count(void **state)
 {
@@ -106,9 +101,9 @@ static void fixture_make(fixture *f)
     assert_int_equal(tcb_atlas_work_create(f->m, B, N, M, &f->w, &err), TCB_OK);
     tcb_rng rng;
     tcb_rng_seed_stream(&rng, 3, "test/atlas/inputs");
-    fill_uniform(&rng, f->clouds, B * N * 3, -0.5, 0.5);
-    fill_uniform(&rng, f->uv, M * 2, 0, 1);
-    for (int k = 0; k < 3; k++) fill_uniform(&rng, f->g[k], B * M * 3, -1, 1);
+    tu_fill_uniform(&rng, f->clouds, B * N * 3, -0.5, 0.5);
+    tu_fill_uniform(&rng, f->uv, M * 2, 0, 1);
+    for (int k = 0; k < 3; k++) tu_fill_uniform(&rng, f->g[k], B * M * 3, -1, 1);
 }
 
 static void fixture_free(fixture *f)

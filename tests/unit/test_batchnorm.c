@@ -33,32 +33,6 @@
 
 /* ---------------------------------------------------------------- helpers */
 
-static float *falloc(size_t n)
-{
-    float *p = calloc(n ? n : 1, sizeof(float));
-    assert_non_null(p);
-    return p;
-}
-
-static double *dalloc(size_t n)
-{
-    double *p = calloc(n ? n : 1, sizeof(double));
-    assert_non_null(p);
-    return p;
-}
-
-static double *to_double(const float *x, size_t n)
-{
-    double *d = dalloc(n);
-    for (size_t i = 0; i < n; i++) d[i] = x[i];
-    return d;
-}
-
-static void fill_uniform(tcb_rng *r, float *x, size_t n, double lo, double hi)
-{
-    for (size_t i = 0; i < n; i++) x[i] = (float)(lo + (hi - lo) * tcb_rng_uniform(r));
-}
-
 static double g_worst_fwd, g_worst_grad; /* the largest errors seen, as fractions of the tolerance */
 
 static void check_forward(const char *what, const float *got, const double *want, size_t n)
@@ -137,7 +111,7 @@ static double bn_objective(void *p)
 {
     bn_ctx *c = p;
     size_t len = (size_t)c->n * c->C;
-    double *y = dalloc(len), sum = 0.0;
+    double *y = tu_dalloc(len), sum = 0.0;
     ref_train(y, NULL, NULL, c->x, c->gamma, c->beta, c->n, c->C);
     for (size_t i = 0; i < len; i++) sum += c->a[i] * y[i];
     free(y);
@@ -164,8 +138,8 @@ static void layer_make(layer *L, int C, tcb_rng *rng)
     assert_null(L->g.mean), assert_null(L->g.var);
     tcb_batchnorm_reset_running(&L->bn);
     for (int c = 0; c < C; c++) assert_true(L->bn.mean[c] == 0.0f && L->bn.var[c] == 1.0f);
-    fill_uniform(rng, L->bn.gamma, C, 0.5, 1.5);
-    fill_uniform(rng, L->bn.beta, C, -0.5, 0.5);
+    tu_fill_uniform(rng, L->bn.gamma, C, 0.5, 1.5);
+    tu_fill_uniform(rng, L->bn.beta, C, -0.5, 0.5);
     memset(L->grads, 0, sizeof L->grads);
 }
 
@@ -188,15 +162,15 @@ static void check_layer(int n, int C, tcb_rng *rng)
     size_t len = (size_t)n * C;
     layer L;
     layer_make(&L, C, rng);
-    float *x = falloc(len), *y = falloc(len), *xhat = falloc(len), *a = falloc(len), *dx = falloc(len);
+    float *x = tu_falloc(len), *y = tu_falloc(len), *xhat = tu_falloc(len), *a = tu_falloc(len), *dx = tu_falloc(len);
     float rstd[512], mu[512], var2[512];
     fill_input(rng, x, n, C);
-    fill_uniform(rng, a, len, -1, 1);
+    tu_fill_uniform(rng, a, len, -1, 1);
 
     /* training forward */
     tcb_batchnorm_forward_train(&L.bn, y, xhat, rstd, mu, var2, x, n, 0);
-    bn_ctx c = {to_double(x, len), to_double(L.bn.gamma, C), to_double(L.bn.beta, C), to_double(a, len), n, C};
-    double *yref = dalloc(len), *xhref = dalloc(len), one[512], zero[512], muref[512], varref[512], rsref[512];
+    bn_ctx c = {tu_to_double(x, len), tu_to_double(L.bn.gamma, C), tu_to_double(L.bn.beta, C), tu_to_double(a, len), n, C};
+    double *yref = tu_dalloc(len), *xhref = tu_dalloc(len), one[512], zero[512], muref[512], varref[512], rsref[512];
     for (int k = 0; k < C; k++) one[k] = 1.0, zero[k] = 0.0;
     ref_train(yref, muref, varref, c.x, c.gamma, c.beta, n, C);
     ref_train(xhref, NULL, NULL, c.x, one, zero, n, C);
@@ -207,7 +181,7 @@ static void check_layer(int n, int C, tcb_rng *rng)
     check_forward("train biased variance", var2, varref, C);
     check_forward("train rstd", rstd, rsref, C);
     /* in place (y aliasing x) gives the same bits */
-    float *yy = falloc(len);
+    float *yy = tu_falloc(len);
     memcpy(yy, x, len * sizeof(float));
     tcb_batchnorm_forward_train(&L.bn, yy, xhat, rstd, mu, var2, yy, n, 0);
     assert_memory_equal(yy, y, len * sizeof(float));
@@ -215,8 +189,8 @@ static void check_layer(int n, int C, tcb_rng *rng)
 
     /* the running statistics, from random ones: momentum 0.1, the variance
      * unbiased by n/(n − 1) */
-    fill_uniform(rng, L.bn.mean, C, -1, 1);
-    fill_uniform(rng, L.bn.var, C, 0.5, 2);
+    tu_fill_uniform(rng, L.bn.mean, C, -1, 1);
+    tu_fill_uniform(rng, L.bn.var, C, 0.5, 2);
     double rm[512], rv[512], want_m[512], want_v[512];
     for (int k = 0; k < C; k++) {
         rm[k] = L.bn.mean[k], rv[k] = L.bn.var[k];
@@ -232,7 +206,7 @@ static void check_layer(int n, int C, tcb_rng *rng)
     tcb_batchnorm_forward_eval(&L.bn, y, x, n, 0);
     ref_eval(yref, c.x, c.gamma, c.beta, rm, rv, n, C);
     check_forward("eval y", y, yref, len);
-    yy = falloc(len);
+    yy = tu_falloc(len);
     memcpy(yy, x, len * sizeof(float));
     tcb_batchnorm_forward_eval(&L.bn, yy, yy, n, 0);
     assert_memory_equal(yy, y, len * sizeof(float));
@@ -247,7 +221,7 @@ static void check_layer(int n, int C, tcb_rng *rng)
     check_grad("dbeta", bn_objective, &c, c.beta, L.g.beta, C);
 
     /* dx aliasing dy: the same bits; dγ, dβ accumulate (now doubled) */
-    float *dd = falloc(len), g0 = L.g.gamma[0], b0 = L.g.beta[C - 1];
+    float *dd = tu_falloc(len), g0 = L.g.gamma[0], b0 = L.g.beta[C - 1];
     memcpy(dd, a, len * sizeof(float));
     tcb_batchnorm_backward(&L.bn, &L.g, dd, dd, NULL, xhat, rstd, n);
     assert_memory_equal(dd, dx, len * sizeof(float));
@@ -282,7 +256,7 @@ static void test_offset_input(void **state)
     for (int r = 0; r < n; r++)
         for (int c = 0; c < C; c++) x[r * C + c] = (float)(100.0 * (c + 1) + 0.1 * (2.0 * tcb_rng_uniform(&rng) - 1.0));
     tcb_batchnorm_forward_train(&L.bn, y, xhat, rstd, mu, var2, x, n, 0);
-    double *xd = to_double(x, n * C), *gd = to_double(L.bn.gamma, C), *bd = to_double(L.bn.beta, C);
+    double *xd = tu_to_double(x, n * C), *gd = tu_to_double(L.bn.gamma, C), *bd = tu_to_double(L.bn.beta, C);
     double yref[n * C], muref[C], varref[C];
     ref_train(yref, muref, varref, xd, gd, bd, n, C);
     check_forward("offset train y", y, yref, n * C);
@@ -312,11 +286,11 @@ static void test_fused_relu(void **state)
     tcb_rng_seed_stream(&rng, 1, "test/batchnorm/relu");
     layer L;
     layer_make(&L, C, &rng);
-    float *x = falloc(len), *a = falloc(len), *y = falloc(len), *yr = falloc(len), *xh = falloc(len),
-          *xhr = falloc(len), *dx = falloc(len), *dxr = falloc(len), *masked = falloc(len);
+    float *x = tu_falloc(len), *a = tu_falloc(len), *y = tu_falloc(len), *yr = tu_falloc(len), *xh = tu_falloc(len),
+          *xhr = tu_falloc(len), *dx = tu_falloc(len), *dxr = tu_falloc(len), *masked = tu_falloc(len);
     float st[3][C], str[3][C];
     fill_input(&rng, x, n, C);
-    fill_uniform(&rng, a, len, -1, 1);
+    tu_fill_uniform(&rng, a, len, -1, 1);
     tcb_batchnorm_forward_train(&L.bn, y, xh, st[0], st[1], st[2], x, n, 0);
     tcb_batchnorm_forward_train(&L.bn, yr, xhr, str[0], str[1], str[2], x, n, 1);
     int zeros = 0;
@@ -328,7 +302,7 @@ static void test_fused_relu(void **state)
     assert_true(zeros > 0 && zeros < (int)len);
     assert_memory_equal(xh, xhr, len * sizeof(float));
     assert_memory_equal(st, str, sizeof st);
-    float *ye = falloc(len), *yer = falloc(len);
+    float *ye = tu_falloc(len), *yer = tu_falloc(len);
     tcb_batchnorm_forward_eval(&L.bn, ye, x, n, 0);
     tcb_batchnorm_forward_eval(&L.bn, yer, x, n, 1);
     for (size_t i = 0; i < len; i++) assert_true(yer[i] == (ye[i] > 0 ? ye[i] : 0.0f));
@@ -356,9 +330,9 @@ static void test_threads(void **state)
     tcb_rng_seed_stream(&rng, 1, "test/batchnorm/threads");
     layer L;
     layer_make(&L, C, &rng);
-    float *x = falloc(len), *a = falloc(len);
+    float *x = tu_falloc(len), *a = tu_falloc(len);
     fill_input(&rng, x, n, C);
-    fill_uniform(&rng, a, len, -1, 1);
+    tu_fill_uniform(&rng, a, len, -1, 1);
     float *out[2][4]; /* per thread count: y, xhat, eval y, dx */
     float st[2][5][C], bufs[2][2 * C], grads[2][2 * C];
     float b0[2 * C];
@@ -367,7 +341,7 @@ static void test_threads(void **state)
     for (int t = 0; t < 2; t++) {
         omp_set_num_threads(t + 1);
         assert_int_equal(omp_get_max_threads(), t + 1);
-        for (int k = 0; k < 4; k++) out[t][k] = falloc(len);
+        for (int k = 0; k < 4; k++) out[t][k] = tu_falloc(len);
         memcpy(L.buffers, b0, sizeof b0);
         memset(L.grads, 0, sizeof L.grads);
         tcb_batchnorm_forward_train(&L.bn, out[t][0], out[t][1], st[t][0], st[t][1], st[t][2], x, n, 0);
@@ -385,8 +359,8 @@ static void test_threads(void **state)
     assert_memory_equal(grads[0], grads[1], sizeof grads[0]);
 
     /* and the chunked parallel forward is right at this size */
-    double *xd = to_double(x, len), *gd = to_double(L.bn.gamma, C), *bd = to_double(L.bn.beta, C);
-    double *yref = dalloc(len), muref[C], varref[C];
+    double *xd = tu_to_double(x, len), *gd = tu_to_double(L.bn.gamma, C), *bd = tu_to_double(L.bn.beta, C);
+    double *yref = tu_dalloc(len), muref[C], varref[C];
     ref_train(yref, muref, varref, xd, gd, bd, n, C);
     check_forward("parallel train y", out[1][0], yref, len);
     check_forward("parallel biased variance", st[1][2], varref, C);

@@ -57,32 +57,6 @@ static const tcb_cc_dims DIMS = {C, Z, H, L};
 
 /* ---------------------------------------------------------------- helpers */
 
-static float *falloc(size_t n)
-{
-    float *p = calloc(n ? n : 1, sizeof(float));
-    assert_non_null(p);
-    return p;
-}
-
-static double *dalloc(size_t n)
-{
-    double *p = calloc(n ? n : 1, sizeof(double));
-    assert_non_null(p);
-    return p;
-}
-
-static double *to_double(const float *x, size_t n)
-{
-    double *d = dalloc(n);
-    for (size_t i = 0; i < n; i++) d[i] = x[i];
-    return d;
-}
-
-static void fill_uniform(tcb_rng *r, float *x, size_t n, double lo, double hi)
-{
-    for (size_t i = 0; i < n; i++) x[i] = (float)(lo + (hi - lo) * tcb_rng_uniform(r));
-}
-
 /* nb clouds of np points, each its own: a random centre in [−0.5, 0.5]³ and
  * a random size in [0.5, 1.5] around points uniform in [−1, 1]³. */
 static void fill_clouds(tcb_rng *r, float *x, int nb, int np)
@@ -134,8 +108,8 @@ static void ref_open(ref *r, const tcb_cc_net *net)
 {
     r->net = net;
     r->abs_tol = ABS_TOL;
-    r->pd = to_double(net->params, net->nparams);
-    r->bd = to_double(net->buffers, net->nbuffers);
+    r->pd = tu_to_double(net->params, net->nparams);
+    r->bd = tu_to_double(net->buffers, net->nbuffers);
     r->nb = NULL;
 }
 
@@ -214,7 +188,7 @@ static void ref_encoder(ref *r, int e, const double *clouds, int nb, int np, int
 {
     const tcb_cc_encoder *E = &r->net->p.enc[e];
     int rows = nb * np;
-    double *h1 = dalloc((size_t)rows * 64), *h2 = dalloc((size_t)rows * 128), *h3 = dalloc((size_t)rows * C);
+    double *h1 = tu_dalloc((size_t)rows * 64), *h2 = tu_dalloc((size_t)rows * 128), *h3 = tu_dalloc((size_t)rows * C);
     double g[64 * C];
     assert_true(nb <= 64);
     ref_linear(r, &E->conv1, h1, clouds, rows);
@@ -255,8 +229,8 @@ static void ref_deform(ref *r, const double *zx, const double *zy, const double 
     int rows = nb * np;
     double lat[64 * 2 * Z], q1[64 * Z], q2[64 * Z / 2];
     assert_true(nb <= 64);
-    double *th = dalloc((size_t)nb * K), *h = dalloc((size_t)rows * H), *v = dalloc((size_t)rows * H);
-    double *o = dalloc((size_t)rows * H);
+    double *th = tu_dalloc((size_t)nb * K), *h = tu_dalloc((size_t)rows * H), *v = tu_dalloc((size_t)rows * H);
+    double *o = tu_dalloc((size_t)rows * H);
     for (int b = 0; b < nb; b++)
         for (int j = 0; j < Z; j++) lat[b * 2 * Z + j] = zx[b * Z + j], lat[b * 2 * Z + Z + j] = zy[b * Z + j];
     ref_linear(r, &P->fc1, q1, lat, nb);
@@ -469,12 +443,12 @@ static tcb_cc_net *make_net(uint64_t seed)
     for (int l = 0; l <= L; l++) convs[nc++] = &net->p.meta[l].conv;
     for (int k = 0; k < nc; k++) {
         double bound = 1.0 / sqrt((double)convs[k]->in);
-        fill_uniform(&rng, convs[k]->W, (size_t)convs[k]->in * convs[k]->out, -bound, bound);
+        tu_fill_uniform(&rng, convs[k]->W, (size_t)convs[k]->in * convs[k]->out, -bound, bound);
     }
     tensor t[MAX_TENSORS];
     int nt = dec_tensors(net, t, enc_tensors(net, 1, t, enc_tensors(net, 0, t, 0)));
     for (int k = 0; k < nt; k++)
-        if (t[k].bn) fill_uniform(&rng, net->params + (t[k].p - net->params), t[k].n, t[k].bn == 1 ? 0.5 : -0.5,
+        if (t[k].bn) tu_fill_uniform(&rng, net->params + (t[k].p - net->params), t[k].n, t[k].bn == 1 ? 0.5 : -0.5,
                                   t[k].bn == 1 ? 1.5 : 0.5);
     /* running means in [−0.5, 0.5], then the variances redrawn in [0.5, 2] */
     for (size_t i = 0; i < net->nbuffers; i++) net->buffers[i] = (float)(tcb_rng_uniform(&rng) - 0.5);
@@ -488,7 +462,7 @@ static tcb_cc_net *make_net(uint64_t seed)
         bns[nb++] = &v->meta[l].bn0;
         if (l < L) bns[nb++] = &v->meta[l].bn1;
     }
-    for (int k = 0; k < nb; k++) fill_uniform(&rng, bns[k]->var, bns[k]->C, 0.5, 2.0);
+    for (int k = 0; k < nb; k++) tu_fill_uniform(&rng, bns[k]->var, bns[k]->C, 0.5, 2.0);
     return net;
 }
 
@@ -739,7 +713,7 @@ static void enc_work_open(enc_work *w)
 {
     tcb_error err = {0};
     assert_int_equal(tcb_cc_encoder_cache_alloc(&w->cache, &DIMS, B, N, &err), TCB_OK);
-    w->scratch = falloc(tcb_cc_encoder_scratch_floats(&DIMS, B, N));
+    w->scratch = tu_falloc(tcb_cc_encoder_scratch_floats(&DIMS, B, N));
 }
 
 static void enc_work_close(enc_work *w)
@@ -761,11 +735,11 @@ static void test_encoder_train(void **state)
         enc_work w;
         enc_work_open(&w);
         float clouds[B * N * 3], a[B * Z];
-        fill_uniform(&rng, clouds, B * N * 3, -1, 1);
-        fill_uniform(&rng, a, B * Z, -1, 1);
-        enc_ctx c = {.e = e, .clouds = to_double(clouds, B * N * 3), .a = to_double(a, B * Z)};
+        tu_fill_uniform(&rng, clouds, B * N * 3, -1, 1);
+        tu_fill_uniform(&rng, a, B * Z, -1, 1);
+        enc_ctx c = {.e = e, .clouds = tu_to_double(clouds, B * N * 3), .a = tu_to_double(a, B * Z)};
         ref_open(&c.r, net);
-        c.r.nb = to_double(net->buffers, net->nbuffers);
+        c.r.nb = tu_to_double(net->buffers, net->nbuffers);
 
         tcb_cc_encoder_forward(&net->p.enc[e], &w.cache, w.scratch, clouds, 1);
         double z[B * Z];
@@ -805,12 +779,12 @@ static void test_encoder_eval(void **state)
     enc_work w;
     enc_work_open(&w);
     float clouds[B * N * 3];
-    fill_uniform(&rng, clouds, B * N * 3, -1, 1);
-    float *b0 = falloc(net->nbuffers);
+    tu_fill_uniform(&rng, clouds, B * N * 3, -1, 1);
+    float *b0 = tu_falloc(net->nbuffers);
     memcpy(b0, net->buffers, net->nbuffers * sizeof(float));
     ref r;
     ref_open(&r, net);
-    double *xd = to_double(clouds, B * N * 3), z[B * Z];
+    double *xd = tu_to_double(clouds, B * N * 3), z[B * Z];
     for (int e = 0; e < 2; e++) {
         tcb_cc_encoder_forward(&net->p.enc[e], &w.cache, w.scratch, clouds, 0);
         ref_begin(&r);
@@ -832,12 +806,12 @@ static void test_count_again(void **state)
     tcb_rng rng;
     tcb_rng_seed_stream(&rng, 1, "test/cc/count-again");
     tcb_cc_net *once = make_net(23), *twice = make_net(23);
-    float *b0 = falloc(once->nbuffers);
+    float *b0 = tu_falloc(once->nbuffers);
     memcpy(b0, once->buffers, once->nbuffers * sizeof(float));
     enc_work w1, w2;
     enc_work_open(&w1), enc_work_open(&w2);
     float clouds[B * N * 3], z1[B * Z];
-    fill_uniform(&rng, clouds, B * N * 3, -1, 1);
+    tu_fill_uniform(&rng, clouds, B * N * 3, -1, 1);
     for (int e = 0; e < 2; e++) {
         tcb_cc_encoder_forward(&once->p.enc[e], &w1.cache, w1.scratch, clouds, 1);
         tcb_cc_encoder_count_again(&once->p.enc[e], &w1.cache);
@@ -886,7 +860,7 @@ static void dec_work_open(dec_work *w, const tcb_cc_net *net)
 {
     tcb_error err = {0};
     assert_int_equal(tcb_cc_deform_cache_alloc(&w->cache, net, B, N, &err), TCB_OK);
-    w->scratch = falloc(tcb_cc_deform_scratch_floats(net, B, N));
+    w->scratch = tu_falloc(tcb_cc_deform_scratch_floats(net, B, N));
 }
 
 static void dec_work_close(dec_work *w)
@@ -904,14 +878,14 @@ static void test_decoder_train(void **state)
     dec_work w;
     dec_work_open(&w, net);
     float zx[B * Z], zy[B * Z], x[R * 3], a[R * 3];
-    fill_uniform(&rng, zx, B * Z, 0, 2); /* latent codes come out of a ReLU */
-    fill_uniform(&rng, zy, B * Z, 0, 2);
-    fill_uniform(&rng, x, R * 3, -1, 1);
-    fill_uniform(&rng, a, R * 3, -1, 1);
-    dec_ctx c = {.zx = to_double(zx, B * Z), .zy = to_double(zy, B * Z), .x = to_double(x, R * 3),
-                 .a = to_double(a, R * 3)};
+    tu_fill_uniform(&rng, zx, B * Z, 0, 2); /* latent codes come out of a ReLU */
+    tu_fill_uniform(&rng, zy, B * Z, 0, 2);
+    tu_fill_uniform(&rng, x, R * 3, -1, 1);
+    tu_fill_uniform(&rng, a, R * 3, -1, 1);
+    dec_ctx c = {.zx = tu_to_double(zx, B * Z), .zy = tu_to_double(zy, B * Z), .x = tu_to_double(x, R * 3),
+                 .a = tu_to_double(a, R * 3)};
     ref_open(&c.r, net);
-    c.r.nb = to_double(net->buffers, net->nbuffers);
+    c.r.nb = tu_to_double(net->buffers, net->nbuffers);
 
     tcb_cc_deform_forward(net, &w.cache, w.scratch, zx, zy, x, 1);
     double out[R * 3];
@@ -938,7 +912,7 @@ static void test_decoder_train(void **state)
         for (size_t i = 0; i < enc[k].n; i++) assert_true(net->grads[(enc[k].p - net->params) + i] == 0.0f);
 
     /* a second backward adds as much again */
-    float *g1 = falloc(net->nparams), dzx1[B * Z], dzy1[B * Z];
+    float *g1 = tu_falloc(net->nparams), dzx1[B * Z], dzy1[B * Z];
     memcpy(g1, net->grads, net->nparams * sizeof(float));
     memcpy(dzx1, dzx, sizeof dzx), memcpy(dzy1, dzy, sizeof dzy);
     tcb_cc_deform_backward(net, &w.cache, w.scratch, a, dzx, dzy);
@@ -964,15 +938,15 @@ static void test_decoder_eval(void **state)
     dec_work w;
     dec_work_open(&w, net);
     float zx[B * Z], zy[B * Z], x[R * 3];
-    fill_uniform(&rng, zx, B * Z, 0, 2);
-    fill_uniform(&rng, zy, B * Z, 0, 2);
-    fill_uniform(&rng, x, R * 3, -1, 1);
-    float *b0 = falloc(net->nbuffers);
+    tu_fill_uniform(&rng, zx, B * Z, 0, 2);
+    tu_fill_uniform(&rng, zy, B * Z, 0, 2);
+    tu_fill_uniform(&rng, x, R * 3, -1, 1);
+    float *b0 = tu_falloc(net->nbuffers);
     memcpy(b0, net->buffers, net->nbuffers * sizeof(float));
     tcb_cc_deform_forward(net, &w.cache, w.scratch, zx, zy, x, 0);
     ref r;
     ref_open(&r, net);
-    double *zxd = to_double(zx, B * Z), *zyd = to_double(zy, B * Z), *xd = to_double(x, R * 3), out[R * 3];
+    double *zxd = tu_to_double(zx, B * Z), *zyd = tu_to_double(zy, B * Z), *xd = tu_to_double(x, R * 3), out[R * 3];
     ref_begin(&r);
     ref_deform(&r, zxd, zyd, xd, B, N, 0, out);
     check_forward("decoder out (eval)", w.cache.out, out, R * 3);
@@ -1028,8 +1002,8 @@ static void test_network_grad(void **state)
     float X[R * 3], Y[R * 3], a[R * 3];
     fill_clouds(&rng, X, B, N);
     fill_clouds(&rng, Y, B, N);
-    fill_uniform(&rng, a, R * 3, -1, 1);
-    net_ctx c = {.X = to_double(X, R * 3), .Y = to_double(Y, R * 3), .a = to_double(a, R * 3)};
+    tu_fill_uniform(&rng, a, R * 3, -1, 1);
+    net_ctx c = {.X = tu_to_double(X, R * 3), .Y = tu_to_double(Y, R * 3), .a = tu_to_double(a, R * 3)};
     ref_open(&c.r, net);
     c.r.abs_tol = 1e-4;
 
@@ -1047,7 +1021,7 @@ static void test_network_grad(void **state)
     check_forward("z_Y", e1.cache.z, zy, B * Z);
     /* the decoder alone at the float codes, then the whole composition (whose
      * float error is the codes' rounding, amplified by the decoder) */
-    double *zxf = to_double(e0.cache.z, B * Z), *zyf = to_double(e1.cache.z, B * Z), stage[R * 3];
+    double *zxf = tu_to_double(e0.cache.z, B * Z), *zyf = tu_to_double(e1.cache.z, B * Z), stage[R * 3];
     ref_deform(&c.r, zxf, zyf, c.X, B, N, 1, stage);
     check_forward("out vs the reference decoder at the float codes", d.cache.out, stage, R * 3);
     check_forward("out vs the composed reference", d.cache.out, out, R * 3);
