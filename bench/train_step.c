@@ -27,7 +27,7 @@
  * cc (tcb_cc_train_step after the warm-up: the batch drawn from the pools
  * and augmented, six network calls, the cycle losses, backward, Adam) at
  * the paper's scale (C 1024, Z 512, H 64, L 6, 16 triplets of 2500 points)
- * and the cpu preset's (C 256, Z 128, H 32, L 6, 8 triplets of 1000),
+ * and the cpu preset's (C 128, Z 64, H 32, L 6, 8 triplets of 500),
  * beside train_step_cc_torch.py (the CC code's train_iteration with its
  * latent reuse, torch.optim.Adam; data loading not timed). GFLOP/it counts
  * cc_bench.h's products; the losses' nearest-neighbour searches are timed
@@ -73,7 +73,7 @@ typedef struct {
     int B, N;
 } cc_preset;
 
-static const cc_preset cc_presets[] = {{"cpu", {256, 128, 32, 6}, 8, 1000}, {"paper", {1024, 512, 64, 6}, 16, 2500}};
+static const cc_preset cc_presets[] = {{"cpu", {128, 64, 32, 6}, 8, 500}, {"paper", {1024, 512, 64, 6}, 16, 2500}};
 
 static const struct {
     const char *name;
