@@ -5,6 +5,7 @@
  * it hands back), which end up in the cell file as status failed/diverged;
  * `herr` collects the harness's own failures, which abort the run. */
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -255,7 +256,22 @@ static void record_failure(tcb_cell_result *c, const tcb_error *merr)
     tcb_summary_init(&c->summary);
 }
 
-int tcb_cell_run(const tcb_cell_job *job, tcb_cell_result *out, tcb_error *err)
+/* The cell's OpenMP thread count (job->threads; 0 leaves the process's)
+ * over the whole cell, evaluation and metrics included, not only the fit:
+ * two `--threads 1` processes on two cores would otherwise each evaluate
+ * with every core's worth of threads, and their barriers spin against each
+ * other (an eval 40x slower than its fit was measured so). Returns the
+ * previous count for restore_threads. */
+static int use_threads(const tcb_cell_job *job)
+{
+    int prev = omp_get_max_threads();
+    if (job->threads > 0) omp_set_num_threads(job->threads);
+    return prev;
+}
+
+static void restore_threads(int prev) { omp_set_num_threads(prev); }
+
+static int run_cell(const tcb_cell_job *job, tcb_cell_result *out, tcb_error *err)
 {
     memset(out, 0, sizeof *out);
     tcb_error merr = {0}, herr = {0};
@@ -282,7 +298,7 @@ fail:
     return tcb_fail(err, herr.code, "%s", herr.msg);
 }
 
-int tcb_cell_eval_pair(const tcb_cell_job *job, int k, tcb_pair_capture *out, tcb_error *err)
+static int eval_one_pair(const tcb_cell_job *job, int k, tcb_pair_capture *out, tcb_error *err)
 {
     memset(out, 0, sizeof *out);
     if (k < 0 || k >= job->split->n_pairs)
@@ -307,6 +323,22 @@ int tcb_cell_eval_pair(const tcb_cell_job *job, int k, tcb_pair_capture *out, tc
     tcb_pair_capture_free(out);
     if (herr.code) return tcb_fail(err, herr.code, "%s", herr.msg);
     return tcb_fail(err, merr.code, "%s: %s", job->method->label, merr.msg);
+}
+
+int tcb_cell_run(const tcb_cell_job *job, tcb_cell_result *out, tcb_error *err)
+{
+    int prev = use_threads(job);
+    int rc = run_cell(job, out, err);
+    restore_threads(prev);
+    return rc;
+}
+
+int tcb_cell_eval_pair(const tcb_cell_job *job, int k, tcb_pair_capture *out, tcb_error *err)
+{
+    int prev = use_threads(job);
+    int rc = eval_one_pair(job, k, out, err);
+    restore_threads(prev);
+    return rc;
 }
 
 void tcb_pair_capture_free(tcb_pair_capture *c)

@@ -9,8 +9,12 @@
  *               cost that many seconds before
  *   faulty      fails on purpose: "mode" = "fit" (an error in fit),
  *               "numeric" (TCB_ERR_NUMERIC from transfer at pair `at`),
- *               "nan" (a NaN point from transfer at pair `at`) */
+ *               "nan" (a NaN point from transfer at pair `at`)
+ *   thread_probe  identity transfer that fails unless it runs with the
+ *               OpenMP thread count its fit was given (ctx->n_threads):
+ *               the cell's thread budget covers the evaluation too */
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,6 +31,7 @@ typedef struct model {
     int at;          /* faulty: the failing transfer call */
     double resumed_fit_s; /* slow_noisy: reported through ctx->resumed_fit_s */
     int calls;
+    int fit_threads; /* thread_probe: ctx->n_threads of the fit */
 } model;
 
 static int parse(const char *params_json, const char *name, model *m, tcb_error *err)
@@ -157,6 +162,34 @@ static int fy_transfer(void *self, const tcb_sequence *seq, int i, int j, const 
     return TCB_OK;
 }
 
+static int tp_create(const char *params_json, void **self, tcb_error *err)
+{
+    return create_as("thread_probe", params_json, self, err);
+}
+
+static int tp_fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_error *err)
+{
+    (void)seq;
+    model *m = self;
+    m->fit_threads = ctx->n_threads;
+    if (omp_get_max_threads() != ctx->n_threads)
+        return tcb_fail(err, TCB_ERR_INTERNAL, "thread_probe: fit given %d threads runs with %d", ctx->n_threads,
+                        omp_get_max_threads());
+    return TCB_OK;
+}
+
+static int tp_transfer(void *self, const tcb_sequence *seq, int i, int j, const float *src, int n,
+                       float *out, tcb_rng *rng, tcb_error *err)
+{
+    (void)seq, (void)i, (void)j, (void)rng;
+    const model *m = self;
+    memcpy(out, src, (size_t)n * 3 * sizeof(float));
+    if (omp_get_max_threads() != m->fit_threads)
+        return tcb_fail(err, TCB_ERR_INTERNAL, "thread_probe: transfer runs with %d threads, the fit was given %d",
+                        omp_get_max_threads(), m->fit_threads);
+    return TCB_OK;
+}
+
 static void destroy(void *self) { free(self); }
 
 static const tcb_method_ops slow_noisy = {
@@ -182,10 +215,20 @@ static const tcb_method_ops faulty = {
     .destroy = destroy,
 };
 
+static const tcb_method_ops thread_probe = {
+    .abi_version = TCB_METHOD_ABI_VERSION,
+    .name = "thread_probe",
+    .description = "test only: fails unless fit and transfer run with the cell's thread count",
+    .create = tp_create,
+    .fit = tp_fit,
+    .transfer = tp_transfer,
+    .destroy = destroy,
+};
+
 const tcb_method_ops *const *tcb_plugin_methods(int *count);
 const tcb_method_ops *const *tcb_plugin_methods(int *count)
 {
-    static const tcb_method_ops *const tables[] = {&slow_noisy, &faulty};
-    *count = 2;
+    static const tcb_method_ops *const tables[] = {&slow_noisy, &faulty, &thread_probe};
+    *count = 3;
     return tables;
 }

@@ -6,7 +6,7 @@ build_harness_methods() {
     # Plug-ins of a sanitized tcbench need the sanitizer runtime too.
     local sanitize=""
     grep -q 'TCB_SANITIZE:BOOL=ON' "$TCB_BUILD_DIR/CMakeCache.txt" && sanitize="-fsanitize=address,undefined"
-    "$CC" -std=c11 -O2 -Wall -Wextra -Werror -D_DEFAULT_SOURCE -shared -fPIC $sanitize \
+    "$CC" -std=c11 -O2 -Wall -Wextra -Werror -D_DEFAULT_SOURCE -shared -fPIC -fopenmp $sanitize \
         -I"$TCB_SOURCE_DIR/include" "$TCB_SOURCE_DIR/tests/integration/harness_methods.c" \
         -L"$TCB_BUILD_DIR" -ltcbench -lcjson -lm -o "$out"
 }

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Runner behaviour beyond the happy path: a method failing in fit or
 # transfer (error, NaN) yields a failed/diverged cell and the run goes on;
+# the cell's thread count holds in its evaluation too;
 # optional objdir datasets are skipped when absent, required ones are an
 # error naming the path; an objdir sequence loads through the cache.
 set -euo pipefail
@@ -45,6 +46,22 @@ for m, (status, text) in expect.items():
 PY
 "$TCBENCH" report runs/faults --quiet
 grep -q "diverged" runs/faults/report/tables.md || { cat runs/faults/report/tables.md; exit 1; }
+
+# ---- a cell's thread count covers its evaluation, not only its fit (two
+# --threads 1 processes on two cores must not each evaluate with two)
+cat > threads.json <<'JSON'
+{ "name": "threads", "splits_dir": "splits", "cache_dir": "",
+  "evaluation": { "pairs": 10, "pool_size": 1000 },
+  "datasets": [ { "name": "synth", "source": "synthetic", "frames": 8,
+                  "sequences": [ { "name": "quadruped_walk", "role": "test" } ] } ],
+  "methods": [ { "name": "thread_probe", "method": "thread_probe" } ] }
+JSON
+for t in 1 3; do
+    OMP_NUM_THREADS=2 "$TCBENCH" run threads.json --plugin "$plugin" --threads $t --out runs/threads-$t --quiet \
+        &> threads.log || true
+    grep -qF "cells: 1 in all, 1 computed, 0 already done, 0 failed" threads.log ||
+        { echo "FAIL: --threads $t"; cat threads.log runs/threads-$t/cells/*/*/*/seed_0.json; exit 1; }
+done
 
 # Bad params are caught before any cell runs.
 sed 's/"mode": "fit"/"mode": "bogus"/' faults.json > badparams.json
