@@ -73,7 +73,7 @@ typedef struct {
     int B, N;
 } cc_preset;
 
-static const cc_preset cc_presets[] = {{"cpu", {128, 64, 32, 6}, 8, 500}, {"paper", {1024, 512, 64, 6}, 16, 2500}};
+static const cc_preset cc_presets[] = {{"cpu", {128, 64, 32, 6, 0}, 8, 500}, {"paper", {1024, 512, 64, 6, 0}, 16, 2500}};
 
 static const struct {
     const char *name;

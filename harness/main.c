@@ -267,7 +267,7 @@ static const command commands[] = {
      "                 processes with --only and --threads 1 use two cores more evenly\n"
      "  --force        recompute cells that are already finished\n"
      "  --quiet        no progress output (also when the CI variable is set)\n"
-     "  --verbose      also the methods' debug lines (a training's loss every 1 000 iterations)\n"
+     "  --verbose      also the methods' debug lines (a training's mean loss every 1 000 iterations)\n"
      "  --report       write the report when the run is done\n"
      "  --plugin SO    load out-of-tree methods from a shared object (repeatable)\n"
      "\n"

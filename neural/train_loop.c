@@ -20,6 +20,14 @@ static void resume(const tcb_train_loop *loop, const tcb_fit_ctx *ctx, const cha
                        e.msg);
 }
 
+/* Iterations between two loss lines: 1 000, or a tenth of a shorter
+ * training, so that every training shows its curve. */
+static long long log_interval(long long total)
+{
+    long long tenth = total / 10;
+    return tenth < 1 ? 1 : tenth < 1000 ? tenth : 1000;
+}
+
 static int run(const tcb_train_loop *loop, const tcb_fit_ctx *ctx, tcb_error *err)
 {
     double start = tcb_now_seconds(), earlier = 0;
@@ -28,15 +36,20 @@ static int run(const tcb_train_loop *loop, const tcb_fit_ctx *ctx, tcb_error *er
     if (ctx->work_dir && loop->checkpoint_every > 0)
         rc = tcb_path_join(ckpt, sizeof ckpt, err, "%s/%s", ctx->work_dir, loop->ckpt_name);
     if (!rc) resume(loop, ctx, ckpt, &earlier);
-    long long total = loop->iterations;
+    long long total = loop->iterations, every = log_interval(total), since = 0;
+    double sum = 0;
     while (!rc && loop->done(loop->trainer) < total) {
         double loss;
         rc = loop->step(loop->trainer, &loss, err);
         long long done = loop->done(loop->trainer);
+        sum += loss, since++;
         if (!rc && (done % 10 == 0 || done == total))
             tcb_report_progress(&ctx->reporter, (double)done, (double)total, loop->name);
-        if (!rc && (done % 1000 == 0 || done == total))
-            tcb_report_log(&ctx->reporter, TCB_LOG_DEBUG, "%s: iteration %lld loss %.6g", loop->name, done, loss);
+        if (!rc && (done % every == 0 || done == total)) {
+            tcb_report_log(&ctx->reporter, TCB_LOG_DEBUG, "%s: iteration %lld mean loss %.6g over the last %lld",
+                           loop->name, done, sum / (double)since, since);
+            sum = 0, since = 0;
+        }
         if (!rc && ckpt[0] && done % loop->checkpoint_every == 0 && done < total)
             rc = loop->save(loop->trainer, earlier + tcb_now_seconds() - start, ckpt, err);
     }

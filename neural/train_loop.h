@@ -1,6 +1,7 @@
 /* The fit loop every trained method runs (the atlas family, cc): resume
  * from the cell's training checkpoint when there is one, step to the last
- * iteration with a progress bar and a debug line every 1 000 iterations,
+ * iteration with a progress bar and a debug line with the mean loss every
+ * 1 000 iterations (a tenth of a shorter training),
  * save the training state every `checkpoint_every` iterations, and delete
  * it at the end (the harness's model checkpoint supersedes it). A
  * checkpoint that cannot be continued (corrupt, other settings) is reported

@@ -12,6 +12,9 @@
  *          fifth method in it, seconds per sequence; far from trained)
  *   tiny   C 16, Z 8, H 8, L 2, 2 triplets of 200 points (tests)
  * Iterations per preset and how they were chosen: docs/protocol.md.
+ * `residual` (default false, as the paper) makes the meta-MLP emit an
+ * offset, x + 2·tanh(·): the CC code's skip_connections, which its
+ * training bypasses (docs/protocol.md C10); the CI training uses it.
  *
  * Read-out (transfer i → j): the GT vertices of i, in i's frame box, are
  * deformed by the network conditioned on (z_i, z_j) with the running
@@ -46,10 +49,10 @@ typedef struct cc_preset {
 } cc_preset;
 
 static const cc_preset presets[] = {
-    {{1024, 512, 64, 6}, 16, 0, 75000},
-    {{128, 64, 32, 6}, 8, 500, 10000},
-    {{32, 16, 16, 4}, 4, 300, 300},
-    {{16, 8, 8, 2}, 2, 200, 60},
+    {{1024, 512, 64, 6, 0}, 16, 0, 75000},
+    {{128, 64, 32, 6, 0}, 8, 500, 10000},
+    {{32, 16, 16, 4, 0}, 4, 300, 300},
+    {{16, 8, 8, 2, 0}, 2, 200, 60},
 };
 static const char *const preset_names[] = {"paper", "cpu", "short", "tiny", NULL}; /* presets[k]; default cpu */
 static const char *const sampling_names[] = {"random", "knn", "neighbors", NULL}; /* tcb_cc_sampling */
@@ -71,6 +74,7 @@ typedef struct cc_method {
 static int parse_numbers(const cJSON *j, const char *where, const cc_preset *pr, cc_method *c, tcb_error *err)
 {
     long long it, C, Z, H, L, batch, points, delta, knn;
+    int residual;
     tcb_cc_train_cfg *t = &c->cfg;
     double def_warmup = t->sampler.sampling == TCB_CC_SAMPLE_RANDOM ? 30.0 / 1500 : 30.0 / 500;
     int rc = tcb_json_int(j, "iterations", where, 0, pr->iterations, 1, 100000000, &it, err);
@@ -78,6 +82,7 @@ static int parse_numbers(const cJSON *j, const char *where, const cc_preset *pr,
     if (!rc) rc = tcb_json_int(j, "latent", where, 0, pr->d.Z, 2, 65536, &Z, err);
     if (!rc) rc = tcb_json_int(j, "hidden", where, 0, pr->d.H, 1, 4096, &H, err);
     if (!rc) rc = tcb_json_int(j, "layers", where, 0, pr->d.L, 1, TCB_CC_MAX_META - 1, &L, err);
+    if (!rc) rc = tcb_json_bool(j, "residual", where, 0, 0, &residual, err);
     if (!rc) rc = tcb_json_int(j, "batch", where, 0, pr->batch, 2, TCB_CC_MAX_BATCH, &batch, err);
     if (!rc) rc = tcb_json_int(j, "points", where, 0, pr->points, 0, 10000000, &points, err);
     if (!rc) rc = tcb_json_num(j, "warmup", where, 0, def_warmup, 0, 1, &c->warmup, err);
@@ -87,7 +92,7 @@ static int parse_numbers(const cJSON *j, const char *where, const cc_preset *pr,
     if (!rc) rc = tcb_json_int(j, "checkpoint_every", where, 0, 500, 0, 100000000, &c->checkpoint_every, err);
     if (!rc) rc = tcb_json_num(j, "divergence", where, 0, 1e4, 0, 1e300, &t->divergence, err);
     if (rc) return rc;
-    c->d = (tcb_cc_dims){(int)C, (int)Z, (int)H, (int)L};
+    c->d = (tcb_cc_dims){(int)C, (int)Z, (int)H, (int)L, residual};
     t->batch = (int)batch, t->iterations = it, c->points = (int)points;
     t->warmup = (long long)(c->warmup * (double)it + 0.5);
     t->sampler.delta = (int)delta, t->sampler.knn_k = (int)knn;
@@ -97,7 +102,7 @@ static int parse_numbers(const cJSON *j, const char *where, const cc_preset *pr,
 static int parse(const char *params_json, const char *where, cc_method *c, tcb_error *err)
 {
     static const char *const keys[] = {"preset", "sampling", "readout", "iterations", "encoder_width", "latent",
-                                       "hidden", "layers", "batch", "points", "warmup", "lr", "delta", "knn",
+                                       "hidden", "layers", "residual", "batch", "points", "warmup", "lr", "delta", "knn",
                                        "checkpoint_every", "divergence", NULL};
     cJSON *j;
     int rc = tcb_params_parse(params_json, where, keys, &j, err);

@@ -134,7 +134,7 @@ void tcb_cc_deform_forward(const tcb_cc_net *net, tcb_cc_deform_cache *c, float 
         }
         h = c->o[l];
     }
-    for (size_t k = 0; k < (size_t)R * 3; k++) c->out[k] = 2.0f * h[k];
+    for (size_t k = 0; k < (size_t)R * 3; k++) c->out[k] = 2.0f * h[k] + (net->d.residual ? x[k] : 0.0f);
 }
 
 /* ---- backward ---- */

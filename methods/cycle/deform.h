@@ -10,10 +10,10 @@
  *       v = u·(W_b + I)        (per shape, row vectors)
  *       r = ReLU(bn0(v))       (bn0 over all B·N points: shapes mix)
  *       o = ReLU(bn1(conv(r))), last layer o = tanh(conv(r))
- *   out [B][N][3] = 2·o_L
+ *   out [B][N][3] = 2·o_L, or x + 2·o_L with dims.residual
  *
  * The gradient reaches θ through W_b and b_b, and the latents through θ;
- * the source points are data (no input gradient). */
+ * the source points are data (no input gradient; the residual's x too). */
 #ifndef TCB_CC_DEFORM_H
 #define TCB_CC_DEFORM_H
 

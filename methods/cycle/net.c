@@ -115,6 +115,8 @@ int tcb_cc_dims_check(const tcb_cc_dims *d, const char *where, tcb_error *err)
     if (d->L < 1 || d->L + 1 > TCB_CC_MAX_META)
         return tcb_fail(err, TCB_ERR_INPUT, "%s: meta-MLP hidden layers L %d outside 1..%d", where, d->L,
                         TCB_CC_MAX_META - 1);
+    if (d->residual != 0 && d->residual != 1)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: residual %d is neither 0 nor 1", where, d->residual);
     return TCB_OK;
 }
 
@@ -223,6 +225,7 @@ cJSON *tcb_cc_net_manifest(const tcb_cc_net *n)
     cJSON_AddNumberToObject(root, "Z", n->d.Z);
     cJSON_AddNumberToObject(root, "H", n->d.H);
     cJSON_AddNumberToObject(root, "L", n->d.L);
+    cJSON_AddBoolToObject(root, "residual", n->d.residual);
     cJSON_AddNumberToObject(root, "nparams", (double)n->nparams);
     cJSON_AddNumberToObject(root, "nbuffers", (double)n->nbuffers);
     cJSON_AddItemToObject(root, "tensors", tensors);

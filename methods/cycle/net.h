@@ -14,7 +14,7 @@
  *              slice of the layer; conv is a fixed d_in→d_out linear map;
  *              act is ReLU with BN1, and tanh without BN1 on the last
  *              layer. The output is 2·tanh(·): an absolute position in
- *              (−2, 2).
+ *              (−2, 2); with `residual`, x + 2·tanh(·), an offset.
  *   K = 12 + L·(H² + H): 24,972 at the CC code's H 64, L 6.
  *
  * Layout. The trained parameters live in ONE flat float vector (and their
@@ -43,6 +43,10 @@ typedef struct tcb_cc_dims {
     int Z; /* latent size of each encoder; Z even */
     int H; /* meta-MLP hidden width */
     int L; /* meta-MLP hidden layers: L + 1 meta layers */
+    int residual; /* 1: out = x + 2·tanh(·), the CC code's skip_connections
+                   * (forward_resnet); 0: the absolute position 2·tanh(·) the
+                   * CC code trains (its training path, forward_classic_with_
+                   * latent, bypasses the skip). Not a trained tensor. */
 } tcb_cc_dims;
 
 #define TCB_CC_ENC1 64  /* PointNet's first two widths, fixed as in the CC code */

@@ -53,7 +53,7 @@
  * fused tiny-output conv, tanh, no bn1); the predictor's fc2 6→3 and fc3
  * 3→K take the fused paths, fc1 12→6 the GEMM. */
 enum { C = 8, Z = 6, H = 5, L = 2, B = 3, N = 7, R = B * N };
-static const tcb_cc_dims DIMS = {C, Z, H, L};
+static const tcb_cc_dims DIMS = {C, Z, H, L, 0};
 
 /* ---------------------------------------------------------------- helpers */
 
@@ -494,7 +494,7 @@ static tcb_cc_net *make_net(uint64_t seed)
 static void test_param_count(void **state)
 {
     (void)state;
-    const tcb_cc_dims paper = {1024, 512, 64, 6};
+    const tcb_cc_dims paper = {1024, 512, 64, 6, 0};
     assert_int_equal(tcb_cc_param_count(&paper), 8436117);
     tcb_cc_net *net;
     tcb_error err = {0};
@@ -512,7 +512,7 @@ static void test_param_count(void **state)
                          (2 * Z * Z + Z + 2 * Z + Z * Z / 2 + Z / 2 + Z + Z / 2 * 72 + 72) +
                          (6 + 3 * H + H + 2 * H) + (2 * H + H * H + H + 2 * H) + (2 * H + 3 * H + 3));
     /* bad dims are refused, naming the one */
-    const tcb_cc_dims odd = {C, 7, H, L}, deep = {C, Z, H, TCB_CC_MAX_META};
+    const tcb_cc_dims odd = {C, 7, H, L, 0}, deep = {C, Z, H, TCB_CC_MAX_META, 0};
     assert_int_equal(tcb_cc_net_create(&odd, &net, &err), TCB_ERR_INPUT);
     assert_non_null(strstr(err.msg, "Z 7"));
     assert_int_equal(tcb_cc_net_create(&deep, &net, &err), TCB_ERR_INPUT);
@@ -639,7 +639,7 @@ static void check_uniform(const float *x, size_t n, int fan_in)
 static void test_init(void **state)
 {
     (void)state;
-    const tcb_cc_dims d = {256, 64, 32, 3};
+    const tcb_cc_dims d = {256, 64, 32, 3, 0};
     tcb_cc_net *net, *again;
     tcb_error err = {0};
     assert_int_equal(tcb_cc_net_create(&d, &net, &err), TCB_OK);
@@ -957,6 +957,39 @@ static void test_decoder_eval(void **state)
     tcb_cc_net_free(net);
 }
 
+/* residual: the same network emits x + its absolute output, in both
+ * modes; the parameter gradients are the same (x is data). */
+static void test_decoder_residual(void **state)
+{
+    (void)state;
+    tcb_rng rng;
+    tcb_rng_seed_stream(&rng, 1, "test/cc/decoder-residual");
+    tcb_cc_net *plain = make_net(31), *res = make_net(31);
+    res->d.residual = 1;
+    dec_work wp, wr;
+    dec_work_open(&wp, plain);
+    dec_work_open(&wr, res);
+    float zx[B * Z], zy[B * Z], x[R * 3], dout[R * 3];
+    tu_fill_uniform(&rng, zx, B * Z, 0, 2);
+    tu_fill_uniform(&rng, zy, B * Z, 0, 2);
+    tu_fill_uniform(&rng, x, R * 3, -1, 1);
+    tu_fill_uniform(&rng, dout, R * 3, -1, 1);
+    for (int train = 0; train < 2; train++) {
+        tcb_cc_deform_forward(plain, &wp.cache, wp.scratch, zx, zy, x, train);
+        tcb_cc_deform_forward(res, &wr.cache, wr.scratch, zx, zy, x, train);
+        for (int k = 0; k < R * 3; k++) assert_true(wr.cache.out[k] == wp.cache.out[k] + x[k]);
+    }
+    float dzx[2][B * Z] = {{0}}, dzy[2][B * Z] = {{0}};
+    tcb_cc_net_zero_grad(plain), tcb_cc_net_zero_grad(res);
+    tcb_cc_deform_backward(plain, &wp.cache, wp.scratch, dout, dzx[0], dzy[0]);
+    tcb_cc_deform_backward(res, &wr.cache, wr.scratch, dout, dzx[1], dzy[1]);
+    assert_memory_equal(plain->grads, res->grads, plain->nparams * sizeof(float));
+    assert_memory_equal(dzx[0], dzx[1], sizeof dzx[0]);
+    assert_memory_equal(dzy[0], dzy[1], sizeof dzy[0]);
+    dec_work_close(&wp), dec_work_close(&wr);
+    tcb_cc_net_free(plain), tcb_cc_net_free(res);
+}
+
 /* ------------------------------------------------- the whole network call */
 
 typedef struct {
@@ -1115,7 +1148,7 @@ static void test_export_import(void **state)
     tcb_cc_net_free(back);
 
     /* other dims: refused, naming the file and the key */
-    const tcb_cc_dims other_h = {C, Z, H + 1, L}, other_c = {2 * C, Z, H, L};
+    const tcb_cc_dims other_h = {C, Z, H + 1, L, 0}, other_c = {2 * C, Z, H, L, 0};
     const char *key[2] = {".H:", ".C:"};
     for (int k = 0; k < 2; k++) {
         assert_int_equal(tcb_cc_net_create(k ? &other_c : &other_h, &back, &err), TCB_OK);
@@ -1139,6 +1172,7 @@ int main(void)
         cmocka_unit_test(test_count_again),
         cmocka_unit_test(test_decoder_train),
         cmocka_unit_test(test_decoder_eval),
+        cmocka_unit_test(test_decoder_residual),
         cmocka_unit_test(test_network_grad),
         cmocka_unit_test_setup_teardown(test_export_import, tu_setup_tmpdir, tu_teardown_tmpdir),
     };

@@ -26,7 +26,7 @@
 
 #define SEED 3
 
-static const tcb_cc_dims tiny = {16, 8, 8, 2};
+static const tcb_cc_dims tiny = {16, 8, 8, 2, 0};
 
 static tcb_sequence make_seq(void)
 {
