@@ -4,6 +4,7 @@
  *   /verts      float32 [F][V][3]     /faces   int32 [NF][3]
  *   /areas      float64 [F]           /norm_shift float64 [F][3]
  *   /pools      float32 [F][P][3]     (absent when P = 0)
+ *   /yaw        float64 [F]           (absent when not rotation-aligned)
  *   attributes on /: format_version, key, name, norm, norm_scale.
  * The file is written under a temporary name and renamed into place. */
 #include <errno.h>
@@ -20,7 +21,7 @@
 #include "tcb/sequence.h"
 
 /* Bump when the layout or the meaning of any field changes. */
-#define CACHE_FORMAT_VERSION 1
+#define CACHE_FORMAT_VERSION 2
 
 /* HDF5 prints its error stack by default; library code must not print, so
  * every entry point silences it and restores the caller's handler after. */
@@ -85,6 +86,7 @@ static int write_contents(hid_t file, const tcb_sequence *s, const char *key)
               write_array(file, "norm_shift", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, shift_dims, s->norm_shift);
     if (!bad && s->pool_size > 0)
         bad = write_array(file, "pools", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, 3, pool_dims, s->pools);
+    if (!bad && s->yaw) bad = write_array(file, "yaw", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, &F, s->yaw);
     return bad ? -1 : 0;
 }
 
@@ -231,7 +233,9 @@ static int alloc_from_shapes(hid_t file, const char *path, tcb_sequence *out, tc
     out->areas = malloc((size_t)out->n_frames * sizeof *out->areas);
     out->norm_shift = malloc((size_t)out->n_frames * 3 * sizeof *out->norm_shift);
     out->pools = has_pools ? malloc((size_t)out->n_frames * (size_t)out->pool_size * 3 * sizeof(float)) : NULL;
-    if (!out->areas || !out->norm_shift || (has_pools && !out->pools))
+    int has_yaw = H5Lexists(file, "yaw", H5P_DEFAULT) > 0;
+    out->yaw = has_yaw ? malloc((size_t)out->n_frames * sizeof *out->yaw) : NULL;
+    if (!out->areas || !out->norm_shift || (has_pools && !out->pools) || (has_yaw && !out->yaw))
         return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", path);
     return TCB_OK;
 }
@@ -250,7 +254,8 @@ static int read_contents(hid_t file, const char *path, tcb_sequence *out, tcb_er
         read_array(file, "faces", H5T_NATIVE_INT32, 2, faces_dims, out->faces) != 0 ||
         read_array(file, "areas", H5T_NATIVE_DOUBLE, 1, &F, out->areas) != 0 ||
         read_array(file, "norm_shift", H5T_NATIVE_DOUBLE, 2, shift_dims, out->norm_shift) != 0 ||
-        (out->pools && read_array(file, "pools", H5T_NATIVE_FLOAT, 3, pool_dims, out->pools) != 0))
+        (out->pools && read_array(file, "pools", H5T_NATIVE_FLOAT, 3, pool_dims, out->pools) != 0) ||
+        (out->yaw && read_array(file, "yaw", H5T_NATIVE_DOUBLE, 1, &F, out->yaw) != 0))
         return corrupt(path, "unreadable attribute or array", err);
     if (norm < TCB_NORM_NONE || norm > TCB_NORM_PER_FRAME) return corrupt(path, "unknown normalization", err);
     out->norm = (tcb_normalization)norm;
@@ -313,8 +318,9 @@ static int sb_printf(strbuf *b, const char *fmt, ...)
 static int build_key(const char *name, const tcb_load_opts *o, int pool_size, const tcb_objdir_frame *frames,
                      int n, strbuf *key)
 {
-    if (sb_printf(key, "tcbench sequence cache v%d\nname=%s\nnorm=%d pool_size=%d pool_seed=%llu\n",
-                  CACHE_FORMAT_VERSION, name, (int)o->norm, pool_size, (unsigned long long)o->pool_seed))
+    if (sb_printf(key, "tcbench sequence cache v%d\nname=%s\nnorm=%d pool_size=%d pool_seed=%llu align=%d\n",
+                  CACHE_FORMAT_VERSION, name, (int)o->norm, pool_size, (unsigned long long)o->pool_seed,
+                  o->align_samples))
         return -1;
     for (int i = 0; i < n; i++)
         if (sb_printf(key, "%s %lld %lld\n", frames[i].name, frames[i].size, frames[i].mtime_ns)) return -1;
@@ -328,12 +334,11 @@ static uint64_t fnv1a(const char *s)
     return h;
 }
 
-static int parse_normalize_sample(const char *dir, const tcb_objdir_frame *frames, int n, const char *name,
-                                  const tcb_load_opts *o, int pool_size, tcb_sequence *out, tcb_error *err)
+static int parse_and_prepare(const char *dir, const tcb_objdir_frame *frames, int n, const char *name,
+                             const tcb_load_opts *o, tcb_sequence *out, tcb_error *err)
 {
     int rc = tcb_objdir_read(dir, frames, n, name, out, err);
-    if (!rc) rc = tcb_sequence_normalize(out, o->norm, err);
-    if (!rc) rc = tcb_sequence_sample_pools(out, pool_size, o->pool_seed, err);
+    if (!rc) rc = tcb_sequence_prepare(out, o, err);
     if (rc) tcb_sequence_free(out);
     return rc;
 }
@@ -354,7 +359,7 @@ static int load_via_cache(const char *dir, const tcb_objdir_frame *frames, int n
         free(key.s);
         return TCB_OK;
     }
-    if (!rc) rc = parse_normalize_sample(dir, frames, n, name, o, pool_size, out, err);
+    if (!rc) rc = parse_and_prepare(dir, frames, n, name, o, out, err);
     if (!rc && (rc = tcb_sequence_cache_save(path, out, key.s, err))) tcb_sequence_free(out);
     free(key.s);
     return rc;
@@ -364,7 +369,7 @@ int tcb_sequence_load_objdir(const char *dir, const char *name, const tcb_load_o
                              tcb_error *err)
 {
     memset(out, 0, sizeof *out);
-    static const tcb_load_opts defaults = {TCB_NORM_NONE, TCB_DEFAULT_POOL_SIZE, 0, NULL};
+    static const tcb_load_opts defaults = {TCB_NORM_NONE, TCB_DEFAULT_POOL_SIZE, 0, NULL, 0};
     const tcb_load_opts *o = opts ? opts : &defaults;
     int pool_size = o->pool_size ? o->pool_size : TCB_DEFAULT_POOL_SIZE;
     char default_name[TCB_NAME_MAX];
@@ -379,7 +384,7 @@ int tcb_sequence_load_objdir(const char *dir, const char *name, const tcb_load_o
     if (o->cache_dir && *o->cache_dir)
         rc = load_via_cache(dir, frames, n, name, o, pool_size, out, err);
     else
-        rc = parse_normalize_sample(dir, frames, n, name, o, pool_size, out, err);
+        rc = parse_and_prepare(dir, frames, n, name, o, out, err);
     free(frames);
     return rc;
 }

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "tcb/align.h"
 #include "tcb/geometry.h"
 
 int tcb_sequence_alloc(tcb_sequence *s, const char *name, int n_frames, int n_verts,
@@ -43,6 +44,7 @@ void tcb_sequence_free(tcb_sequence *s)
     free(s->areas);
     free(s->pools);
     free(s->norm_shift);
+    free(s->yaw);
     memset(s, 0, sizeof *s);
 }
 
@@ -131,6 +133,20 @@ int tcb_sequence_sample_pools(tcb_sequence *s, int pool_size, uint64_t seed, tcb
     s->pools = pools;
     s->pool_size = pool_size;
     return TCB_OK;
+}
+
+int tcb_sequence_prepare(tcb_sequence *s, const tcb_load_opts *o, tcb_error *err)
+{
+    int rc = tcb_sequence_normalize(s, o->norm, err);
+    if (!rc && o->align_samples > 0) {
+        int *step = malloc((size_t)s->n_frames * sizeof *step);
+        rc = step ? tcb_align_yaw(s, o->align_samples, o->pool_seed, step, NULL, err)
+                  : tcb_fail(err, TCB_ERR_NOMEM, "sequence %s: out of memory", s->name);
+        if (!rc) rc = tcb_sequence_apply_yaw(s, step, err);
+        free(step);
+    }
+    if (!rc) rc = tcb_sequence_sample_pools(s, o->pool_size ? o->pool_size : TCB_DEFAULT_POOL_SIZE, o->pool_seed, err);
+    return rc;
 }
 
 static void copy_point(float *dst, const float *pool, uint32_t k)

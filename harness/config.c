@@ -21,9 +21,9 @@ static const char *const top_keys[] = {"name", "output", "splits_dir", "cache_di
 static const char *const eval_keys[] = {"pairs", "split_seed", "pool_size", "pool_seed",
                                         "input_points", NULL};
 static const char *const synthetic_keys[] = {"name", "source", "seed", "frames", "normalization",
-                                             "sampling", "sequences", NULL};
+                                             "align_rotation", "sampling", "sequences", NULL};
 static const char *const objdir_keys[] = {"name", "source", "root", "optional", "normalization",
-                                          "sampling", "sequences", NULL};
+                                          "align_rotation", "sampling", "sequences", NULL};
 static const char *const sequence_keys[] = {"name", "role", NULL};
 static const char *const method_keys[] = {"name", "method", "params", "seeds", NULL};
 
@@ -160,6 +160,7 @@ static int parse_dataset(const cJSON *o, const char *where, tcb_dataset_spec *d,
     if (!rc)
         rc = tcb_json_enum(o, "normalization", where, 0, TCB_NORM_FIRST_FRAME, tcb_config_norm_names, &norm,
                            err);
+    if (!rc) rc = tcb_json_bool(o, "align_rotation", where, 0, 0, &d->align_rotation, err);
     if (!rc) rc = tcb_json_enum(o, "sampling", where, 0, 0, tcb_config_sampling_names, &sampling, err);
     if (rc) return rc;
     if (!synthetic && !root[0])

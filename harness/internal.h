@@ -106,4 +106,15 @@ typedef struct tcb_pair_capture {
 int tcb_cell_eval_pair(const tcb_cell_job *job, int k, tcb_pair_capture *out, tcb_error *err);
 void tcb_pair_capture_free(tcb_pair_capture *c);
 
+/* `tcbench datasets align`: the rotation alignment of an OBJ directory
+ * (centred per frame) written as JSON to `out` and, with `plot`, as a PNG
+ * of the yaw per frame; both atomically. (harness/align_cmd.c) */
+typedef struct tcb_align_cmd {
+    const char *out;   /* rotations.json */
+    const char *plot;  /* NULL: no plot */
+    int samples;       /* points per frame for the Chamfer */
+    uint64_t seed;     /* of those samples */
+} tcb_align_cmd;
+int tcb_datasets_align(const char *dir, const tcb_align_cmd *a, tcb_error *err);
+
 #endif

@@ -17,7 +17,7 @@
 
 enum {
     F_OUT, F_ONLY, F_FORCE, F_QUIET, F_REPORT, F_SEED, F_FRAMES, F_SEQUENCE, F_UPDATE,
-    F_PLUGIN, F_THREADS, F_VERBOSE, F_HELP, F_COUNT
+    F_PLUGIN, F_THREADS, F_VERBOSE, F_SAMPLES, F_PLOT, F_HELP, F_COUNT
 };
 #define BIT(f) (1u << (f))
 
@@ -29,7 +29,7 @@ static const struct {
     [F_QUIET] = {"--quiet", 0},  [F_REPORT] = {"--report", 0},   [F_SEED] = {"--seed", 1},
     [F_FRAMES] = {"--frames", 1}, [F_SEQUENCE] = {"--sequence", 1}, [F_UPDATE] = {"--update", 0},
     [F_PLUGIN] = {"--plugin", 1}, [F_THREADS] = {"--threads", 1}, [F_VERBOSE] = {"--verbose", 0},
-    [F_HELP] = {"--help", 0},
+    [F_SAMPLES] = {"--samples", 1}, [F_PLOT] = {"--plot", 1}, [F_HELP] = {"--help", 0},
 };
 
 #define MAX_PLUGINS 64
@@ -182,11 +182,34 @@ static int datasets_synth(const cli *c)
     return 0;
 }
 
+static int datasets_align(const cli *c)
+{
+    long long seed, samples;
+    if (c->n_args != 2) return usage_error("datasets align", "missing %s", "DIR");
+    if (!c->value[F_OUT]) return usage_error("datasets align", "%s is required", "--out FILE");
+    if (c->set[F_FRAMES] || c->set[F_SEQUENCE])
+        return usage_error("datasets align", "%s applies to 'datasets synth' only",
+                           c->set[F_FRAMES] ? "--frames" : "--sequence");
+    if (int_option(c, F_SEED, 0, &seed) || int_option(c, F_SAMPLES, TCB_ALIGN_DEFAULT_SAMPLES, &samples)) return 2;
+    if (samples < 1 || samples > 10000000)
+        return usage_error("datasets align", "--samples %lld outside 1..10000000", samples);
+    tcb_align_cmd a = {c->value[F_OUT], c->value[F_PLOT], (int)samples, (uint64_t)seed};
+    tcb_error err = {0};
+    if (tcb_datasets_align(c->arg[1], &a, &err)) return fail(&err);
+    fprintf(stderr, "wrote %s%s%s\n", a.out, a.plot ? " and " : "", a.plot ? a.plot : "");
+    return 0;
+}
+
 static int cmd_datasets(const cli *c)
 {
+    if (strcmp(c->arg[0], "align") == 0) return datasets_align(c);
+    if (c->n_args > 1) return usage_error("datasets", "unexpected argument '%s'", c->arg[1]);
+    if (c->set[F_SAMPLES] || c->set[F_PLOT])
+        return usage_error("datasets", "%s applies to 'datasets align' only",
+                           c->set[F_SAMPLES] ? "--samples" : "--plot");
     if (strcmp(c->arg[0], "synth") == 0) return datasets_synth(c);
     if (strcmp(c->arg[0], "list") != 0)
-        return usage_error("datasets", "unknown action '%s' (expected list or synth)", c->arg[0]);
+        return usage_error("datasets", "unknown action '%s' (expected list, synth or align)", c->arg[0]);
     for (int f = 0; f < F_COUNT; f++)
         if (f != F_PLUGIN && c->set[f])
             return usage_error("datasets list", "%s applies to 'datasets synth' only", flags[f].name);
@@ -297,23 +320,33 @@ static const command commands[] = {
      "\n"
      "example:\n"
      "  tcbench methods --plugin build/examples/libmy_method.so\n"},
-    {"datasets", cmd_datasets, BIT(F_OUT) | BIT(F_SEED) | BIT(F_FRAMES) | BIT(F_SEQUENCE), 1, 1,
-     "ACTION (list or synth)",
+    {"datasets", cmd_datasets,
+     BIT(F_OUT) | BIT(F_SEED) | BIT(F_FRAMES) | BIT(F_SEQUENCE) | BIT(F_SAMPLES) | BIT(F_PLOT), 1, 2,
+     "ACTION (list, synth or align)",
      "usage: tcbench datasets list\n"
      "       tcbench datasets synth --out DIR [--seed N] [--frames N] [--sequence NAME]\n"
+     "       tcbench datasets align DIR --out FILE [--samples N] [--seed N] [--plot PNG]\n"
      "\n"
      "list:  the embedded synthetic sequences.\n"
      "synth: writes synthetic sequences as OBJ files, DIR/<name>/mesh_NNNN.obj\n"
      "       (raw coordinates, before normalization).\n"
+     "align: the rotation alignment of an OBJ directory (AMA, paper 4.2): each frame,\n"
+     "       centred, turned about y by the multiple of 3 degrees that minimises the\n"
+     "       Chamfer distance to the aligned previous frame; writes the angles per\n"
+     "       frame as JSON (what a config's \"align_rotation\": true applies).\n"
      "\n"
      "options:\n"
-     "  --out DIR        output directory (synth; required)\n"
-     "  --seed N         generator seed (default 0)\n"
+     "  --out DIR|FILE   output directory (synth) or rotations file (align); required\n"
+     "  --seed N         generator seed (synth), sample seed (align; a run uses its\n"
+     "                   pool_seed); default 0\n"
      "  --frames N       frames per sequence (default: the sequence's own length)\n"
      "  --sequence NAME  only this sequence (default: all)\n"
+     "  --samples N      align: points per frame for the Chamfer (default 1000)\n"
+     "  --plot PNG       align: also plot the angle per frame\n"
      "\n"
-     "example:\n"
-     "  tcbench datasets synth --out data/synth --sequence quadruped_walk\n"},
+     "examples:\n"
+     "  tcbench datasets synth --out data/synth --sequence quadruped_walk\n"
+     "  tcbench datasets align ../shared/data/ama/crane --out crane-rotations.json --plot crane-yaw.png\n"},
     {"check", cmd_check, BIT(F_UPDATE), 2, 2, "RUN_DIR BASELINE",
      "usage: tcbench check RUN_DIR BASELINE [--update]\n"
      "\n"
@@ -379,7 +412,7 @@ static const char general_help[] =
     "  run       run the grid of a config (resumable)\n"
     "  report    tables and plots from a run directory\n"
     "  methods   list the registered methods\n"
-    "  datasets  list or export the synthetic sequences\n"
+    "  datasets  list or export the synthetic sequences, align an OBJ sequence's rotations\n"
     "  check     compare a run with a baseline (CI regression check)\n"
     "  inspect   one evaluation pair as coloured meshes, checked against the run\n"
     "  version   print the version\n"

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "harness/internal.h"
+#include "tcb/align.h"
 #include "tcb/fsutil.h"
 #include "tcb/registry.h"
 #include "tcb/synth.h"
@@ -139,17 +140,16 @@ int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, 
                               tcb_sequence *seq, tcb_error *err)
 {
     int rc;
+    tcb_load_opts lo = {d->norm, cfg->pool_size, cfg->pool_seed, cfg->cache_dir[0] ? cfg->cache_dir : NULL,
+                        d->align_rotation ? TCB_ALIGN_DEFAULT_SAMPLES : 0};
     if (d->source == TCB_SOURCE_SYNTHETIC) {
         rc = tcb_synth_generate(name, d->seed, d->frames, seq, err);
-        if (!rc) rc = tcb_sequence_normalize(seq, d->norm, err);
-        if (!rc) rc = tcb_sequence_sample_pools(seq, cfg->pool_size, cfg->pool_seed, err);
+        if (!rc) rc = tcb_sequence_prepare(seq, &lo, err);
     } else {
         char dir[TCB_PATH_MAX];
         rc = tcb_path_join(dir, sizeof dir, err, "%s/%s", d->root, name);
         if (!rc && !tcb_is_dir(dir))
             rc = tcb_fail(err, TCB_ERR_IO, "%s: no such directory", dir);
-        tcb_load_opts lo = {d->norm, cfg->pool_size, cfg->pool_seed,
-                            cfg->cache_dir[0] ? cfg->cache_dir : NULL};
         if (!rc) rc = tcb_sequence_load_objdir(dir, name, &lo, seq, err);
     }
     if (rc) {

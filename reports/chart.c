@@ -176,23 +176,27 @@ void tcb_chart_legend(tcb_chart *c, const tcb_rpt_block *b, const char *heading,
     }
 }
 
-void tcb_chart_title(tcb_chart *c, const tcb_rpt_block *b, const char *what)
+void tcb_chart_headline(tcb_chart *c, const char *title, const char *subtitle)
 {
     cairo_t *cr = c->cr;
-    char s[512];
     cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
     font(cr, 19, 1);
-    snprintf(s, sizeof s, "%s — %s / %s", what, b->dataset, b->sequence);
-    text(cr, X0, 36, 0, s);
+    text(cr, X0, 36, 0, title);
     font(cr, 13, 0);
     cairo_set_source_rgb(cr, 0.38, 0.38, 0.38);
+    text(cr, X0, 58, 0, subtitle);
+}
+
+void tcb_chart_title(tcb_chart *c, const tcb_rpt_block *b, const char *what)
+{
+    char title[512], sub[512];
+    snprintf(title, sizeof title, "%s — %s / %s", what, b->dataset, b->sequence);
     if (b->n_pairs_min == b->n_pairs_max)
-        snprintf(s, sizeof s, "%s sequence · %d pairs · seeds %s", b->role, b->n_pairs_min,
-                 b->seeds);
+        snprintf(sub, sizeof sub, "%s sequence · %d pairs · seeds %s", b->role, b->n_pairs_min, b->seeds);
     else
-        snprintf(s, sizeof s, "%s sequence · %d–%d pairs · seeds %s", b->role, b->n_pairs_min,
+        snprintf(sub, sizeof sub, "%s sequence · %d–%d pairs · seeds %s", b->role, b->n_pairs_min,
                  b->n_pairs_max, b->seeds);
-    text(cr, X0, 58, 0, s);
+    tcb_chart_headline(c, title, sub);
 }
 
 int tcb_chart_finish(tcb_chart *c, const char *path, tcb_error *err)

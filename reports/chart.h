@@ -44,7 +44,11 @@ void tcb_chart_series_end(tcb_chart *c);
  * for ok rows, "method: status" in grey otherwise. */
 void tcb_chart_legend(tcb_chart *c, const tcb_rpt_block *b, const char *heading, int metric);
 
-/* "<what> — dataset / sequence" and the block's role, pairs and seeds. */
+/* A title line and a grey subtitle line above the axes. */
+void tcb_chart_headline(tcb_chart *c, const char *title, const char *subtitle);
+
+/* tcb_chart_headline with "<what> — dataset / sequence" and the block's
+ * role, pairs and seeds. */
 void tcb_chart_title(tcb_chart *c, const tcb_rpt_block *b, const char *what);
 
 /* Writes the PNG to a temporary beside `path` and renames it into place. */

@@ -12,6 +12,7 @@
  *     "datasets": [
  *       { "name": "synth", "source": "synthetic", "seed": 0, "frames": 0,
  *         "normalization": "first_frame" | "none" | "per_frame",
+ *         "align_rotation": false,       yaw-align each frame to the previous (AMA; tcb/align.h)
  *         "sampling": "without_replacement" | "with_replacement",
  *         "optional": false,             skip (with a message) when root is absent
  *         "root": "../shared/data/anim", objdir sources only: <root>/<sequence>/
@@ -48,6 +49,7 @@ typedef struct tcb_dataset_spec {
     uint64_t seed;           /* synthetic generator seed */
     int frames;              /* synthetic: 0 = default length */
     tcb_normalization norm;
+    int align_rotation;      /* tcb/align.h after the normalization */
     int with_replacement;
     int optional;
     int n_sequences;

@@ -31,6 +31,11 @@ int tcb_baseline_write(const char *run_dir, const char *baseline_path, tcb_error
 int tcb_check(const char *run_dir, const char *baseline_path, FILE *out, int *n_drift,
               tcb_error *err);
 
+/* A PNG of the yaw step[f] · 3° the rotation alignment chose per frame
+ * (tcb/align.h), written atomically. */
+int tcb_plot_yaw(const char *path, const char *sequence, const int *step, int n_frames, int samples,
+                 tcb_error *err);
+
 #ifdef __cplusplus
 }
 #endif

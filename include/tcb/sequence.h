@@ -44,6 +44,8 @@ typedef struct tcb_sequence {
     tcb_normalization norm;
     double norm_scale;  /* FIRST_FRAME: the divisor; 1 otherwise */
     double *norm_shift; /* [n_frames][3] subtracted before scaling */
+    double *yaw;        /* [n_frames] radians about y applied after the normalization
+                         * (rotation alignment, tcb/align.h); NULL when not aligned */
     /* The dataset's input protocol (§1.2), set by the harness from the
      * config: a method's input cloud is input_points draws from a pool,
      * with or without replacement (see tcb_sequence_draw_points). */
@@ -93,9 +95,16 @@ void tcb_sequence_free(tcb_sequence *s);
 typedef struct tcb_load_opts {
     tcb_normalization norm;
     int pool_size;         /* TCB_DEFAULT_POOL_SIZE */
-    uint64_t pool_seed;
+    uint64_t pool_seed;    /* also seeds the alignment's samples */
     const char *cache_dir; /* NULL: no cache */
+    int align_samples;     /* > 0: rotation alignment (tcb/align.h) on that many
+                            * points per frame; 0: none */
 } tcb_load_opts;
+
+/* What every loader does after reading raw frames: normalize, align the
+ * yaw when o->align_samples > 0, sample the pools (o->pool_size, 0 for the
+ * default). */
+int tcb_sequence_prepare(tcb_sequence *s, const tcb_load_opts *o, tcb_error *err);
 
 /* Read an OBJ directory, normalize and sample pools; with a cache_dir the
  * result is stored as HDF5 and later loads skip parsing. A cache entry is

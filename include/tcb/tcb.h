@@ -11,6 +11,7 @@
 #include "tcb/geometry.h"
 #include "tcb/mesh.h"
 #include "tcb/sequence.h"
+#include "tcb/align.h"
 #include "tcb/synth.h"
 #include "tcb/split.h"
 #include "tcb/metrics.h"

@@ -51,13 +51,15 @@ static void assert_same_sequence(const tcb_sequence *a, const tcb_sequence *b)
     assert_memory_equal(a->areas, b->areas, sizeof(double) * F);
     assert_memory_equal(a->norm_shift, b->norm_shift, sizeof(double) * 3 * F);
     assert_memory_equal(a->pools, b->pools, sizeof(float) * 3 * F * (size_t)a->pool_size);
+    assert_int_equal(a->yaw != NULL, b->yaw != NULL);
+    if (a->yaw) assert_memory_equal(a->yaw, b->yaw, sizeof(double) * F);
 }
 
 static void load_fresh(const char *dir, tcb_sequence *s)
 {
     char frames[TCB_PATH_MAX];
     snprintf(frames, sizeof frames, "%s/frames", dir);
-    tcb_load_opts o = {TCB_NORM_FIRST_FRAME, 50, 3, NULL};
+    tcb_load_opts o = {TCB_NORM_FIRST_FRAME, 50, 3, NULL, 0};
     tcb_error err = {0};
     assert_int_equal(tcb_sequence_load_objdir(frames, "pyramid", &o, s, &err), TCB_OK);
 }
@@ -192,7 +194,7 @@ static void test_load_objdir_uses_cache(void **state)
     snprintf(frames, sizeof frames, "%s/frames", dir);
     snprintf(cache, sizeof cache, "%s/cache", dir);
     snprintf(frame0, sizeof frame0, "%s/frames/mesh_0000.obj", dir);
-    tcb_load_opts o = {TCB_NORM_PER_FRAME, 40, 11, cache};
+    tcb_load_opts o = {TCB_NORM_PER_FRAME, 40, 11, cache, 0};
     tcb_sequence first, second, plain;
     tcb_error err = {0};
     assert_int_equal(tcb_sequence_load_objdir(frames, NULL, &o, &first, &err), TCB_OK);
@@ -214,8 +216,31 @@ static void test_load_objdir_uses_cache(void **state)
     o.pool_seed = 12;
     assert_int_equal(tcb_sequence_load_objdir(frames, NULL, &o, &second, &err), TCB_ERR_INPUT);
     assert_non_null(strstr(err.msg, frame0));
+    o.pool_seed = 11, o.align_samples = 64;
+    assert_int_equal(tcb_sequence_load_objdir(frames, NULL, &o, &second, &err), TCB_ERR_INPUT);
     assert_int_equal(count_cache_files(cache), 1);
     tcb_sequence_free(&first);
+}
+
+/* A rotation-aligned load caches its yaws with it. */
+static void test_aligned_load_caches_yaw(void **state)
+{
+    const char *dir = *state;
+    write_frames(dir, 4);
+    char frames[TCB_PATH_MAX], cache[TCB_PATH_MAX];
+    snprintf(frames, sizeof frames, "%s/frames", dir);
+    snprintf(cache, sizeof cache, "%s/cache", dir);
+    tcb_load_opts o = {TCB_NORM_PER_FRAME, 40, 11, cache, 64};
+    tcb_sequence first, again, plain;
+    tcb_error err = {0};
+    assert_int_equal(tcb_sequence_load_objdir(frames, NULL, &o, &first, &err), TCB_OK);
+    assert_non_null(first.yaw);
+    assert_int_equal(tcb_sequence_load_objdir(frames, NULL, &o, &again, &err), TCB_OK);
+    assert_same_sequence(&first, &again);
+    o.cache_dir = NULL;
+    assert_int_equal(tcb_sequence_load_objdir(frames, NULL, &o, &plain, &err), TCB_OK);
+    assert_same_sequence(&first, &plain);
+    tcb_sequence_free(&first), tcb_sequence_free(&again), tcb_sequence_free(&plain);
 }
 
 static void test_load_objdir_rebuilds_stale_entry(void **state)
@@ -225,7 +250,7 @@ static void test_load_objdir_rebuilds_stale_entry(void **state)
     char frames[TCB_PATH_MAX], cache[TCB_PATH_MAX];
     snprintf(frames, sizeof frames, "%s/frames", dir);
     snprintf(cache, sizeof cache, "%s/cache", dir);
-    tcb_load_opts o = {TCB_NORM_FIRST_FRAME, 0, 0, cache}; /* 0: default pool size */
+    tcb_load_opts o = {TCB_NORM_FIRST_FRAME, 0, 0, cache, 0}; /* 0: default pool size */
     tcb_sequence a, b;
     tcb_error err = {0};
     assert_int_equal(tcb_sequence_load_objdir(frames, "p", &o, &a, &err), TCB_OK);
@@ -256,6 +281,7 @@ int main(void)
 #define T(f) cmocka_unit_test_setup_teardown(f, tu_setup_tmpdir, tu_teardown_tmpdir)
     const struct CMUnitTest tests[] = {
         T(test_round_trip_bit_exact),
+        T(test_aligned_load_caches_yaw),
         T(test_long_key),
         T(test_corrupt_and_foreign_files),
         T(test_load_objdir_uses_cache),
