@@ -35,6 +35,7 @@ static const atlas_preset presets[] = {
     {32, 4, 200, 300},
 };
 static const char *const preset_names[] = {"paper", "cpu", "tiny", NULL}; /* presets[k]; default cpu */
+static const char *const pair_names[] = {"neighbors", "random", NULL};     /* training pairs; Table 2 */
 
 typedef struct atlas_method {
     const char *name;           /* the method's, for messages */
@@ -52,7 +53,7 @@ typedef struct atlas_method {
 static int parse(const char *params_json, const char *where, atlas_method *a, tcb_error *err)
 {
     static const char *const keys[] = {"preset", "iterations", "latent", "patches", "uv_samples",
-                                       "alpha_mc", "alpha_sciso", "delta", "lr", "checkpoint_every",
+                                       "alpha_mc", "alpha_sciso", "pairs", "delta", "lr", "checkpoint_every",
                                        "divergence", NULL};
     cJSON *j;
     int rc = tcb_params_parse(params_json, where, keys, &j, err);
@@ -68,6 +69,8 @@ static int parse(const char *params_json, const char *where, atlas_method *a, tc
     if (!rc) rc = tcb_json_int(j, "uv_samples", where, 0, pr->M, 1, 10000000, &M, err);
     if (!rc) rc = tcb_json_num(j, "alpha_mc", where, 0, 0.1, 0, 1e6, &c->alpha_mc, err);
     if (!rc) rc = tcb_json_num(j, "alpha_sciso", where, 0, 0.001, 0, 1e6, &c->alpha_sciso, err);
+    int pairs = 0;
+    if (!rc) rc = tcb_json_enum(j, "pairs", where, 0, 0, pair_names, &pairs, err);
     if (!rc) rc = tcb_json_int(j, "delta", where, 0, 1, 1, 1000000, &delta, err);
     if (!rc) rc = tcb_json_num(j, "lr", where, 0, 1e-3, 1e-12, 10, &c->lr, err);
     if (!rc) rc = tcb_json_int(j, "checkpoint_every", where, 0, 1000, 0, 100000000, &a->checkpoint_every, err);
@@ -79,6 +82,7 @@ static int parse(const char *params_json, const char *where, atlas_method *a, tc
                         P);
     a->C = (int)C, a->P = (int)P;
     c->M = (int)M, c->iterations = it, c->delta = (int)delta;
+    c->pairs = pairs ? TCB_PAIRS_RANDOM : TCB_PAIRS_NEIGHBORS;
     return TCB_OK;
 }
 

@@ -21,7 +21,8 @@ int tcb_atlas_trainer_create(const tcb_atlas_train_cfg *cfg, tcb_atlas_model *mo
                         "atlas: sequence %s needs at least 2 frames, point pools and input_points > 0 "
                         "(has %d frames, pool %d, input_points %d)",
                         seq->name, seq->n_frames, seq->pool_size, seq->input_points);
-    if (cfg->M < model->P || cfg->M % model->P || cfg->delta < 1 || cfg->iterations < 1 || cfg->divergence < 0)
+    if (cfg->M < model->P || cfg->M % model->P || cfg->delta < 1 || cfg->iterations < 1 || cfg->divergence < 0 ||
+        (cfg->pairs != TCB_PAIRS_NEIGHBORS && cfg->pairs != TCB_PAIRS_RANDOM))
         return tcb_fail(err, TCB_ERR_INPUT,
                         "atlas: uv_samples %d must be a positive multiple of patches %d, delta %d ≥ 1, "
                         "iterations %lld ≥ 1, divergence %g ≥ 0", cfg->M, model->P, cfg->delta, cfg->iterations,
@@ -58,13 +59,13 @@ void tcb_atlas_trainer_free(tcb_atlas_trainer *t)
     free(t);
 }
 
-/* Two neighbour pairs, their clouds and the shared UV samples. */
+/* Two training pairs, their clouds and the shared UV samples. */
 static int draw_batch(tcb_atlas_trainer *t, const tcb_sequence *seq, tcb_error *err)
 {
     for (int p = 0; p < TCB_ATLAS_BATCH / 2; p++) {
         int a = (int)tcb_rng_below(&t->rng, (uint32_t)seq->n_frames);
-        int b = tcb_pair_sample(TCB_PAIRS_NEIGHBORS, t->cfg.delta, seq->n_frames, a, &t->rng);
-        if (b < 0) return tcb_fail(err, TCB_ERR_INTERNAL, "atlas: no neighbour of frame %d", a);
+        int b = tcb_pair_sample(t->cfg.pairs, t->cfg.delta, seq->n_frames, a, &t->rng);
+        if (b < 0) return tcb_fail(err, TCB_ERR_INTERNAL, "atlas: no partner frame for frame %d", a);
         t->frames[2 * p] = a, t->frames[2 * p + 1] = b;
     }
     for (int k = 0; k < TCB_ATLAS_BATCH; k++) {

@@ -11,6 +11,7 @@
 #include "tcb/error.h"
 #include "tcb/rng.h"
 #include "tcb/sequence.h"
+#include "tcb/split.h"
 
 /* The three methods differ only here. */
 typedef enum tcb_atlas_loss {
@@ -24,7 +25,9 @@ typedef struct tcb_atlas_train_cfg {
     int M;                  /* UV samples per shape and iteration, a multiple of P */
     long long iterations;   /* total, for the lr schedule */
     double lr, alpha_mc, alpha_sciso;
-    int delta;              /* neighbour pairs: 1 ≤ |a − b| ≤ delta */
+    tcb_pair_mode pairs;    /* NEIGHBORS (1 ≤ |a − b| ≤ delta, the paper's) or RANDOM
+                             * (b uniform over the other frames: Table 2) */
+    int delta;
     double divergence;      /* a loss above divergence × the first one stops training */
 } tcb_atlas_train_cfg;
 

@@ -250,7 +250,10 @@ static void test_damaged_and_foreign_refused(void **state)
     memcpy(buf, "TCBATRN1", 8); /* the format before training times were kept */
     rewrite(path, buf, len);
     expect_refused(t, &s, path, "magic");
-    memcpy(buf, "TCBATRN2", 8);
+    memcpy(buf, "TCBATRN2", 8); /* the format before the pairs mode was kept */
+    rewrite(path, buf, len);
+    expect_refused(t, &s, path, "magic");
+    memcpy(buf, "TCBATRN3", 8);
     rewrite(path, buf, len);
     double seconds;
     assert_int_equal(tcb_atlas_train_ckpt_load(t, &s, SEED, path, &seconds, &err), TCB_OK);

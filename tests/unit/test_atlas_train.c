@@ -205,6 +205,49 @@ static void test_nan_is_numeric(void **state)
     tcb_sequence_free(&s);
 }
 
+/* pairs: neighbors keeps |a − b| ≤ delta; random reaches farther frames
+ * (Table 2's switch), and the method param selects it. */
+static void test_pairs_modes(void **state)
+{
+    (void)state;
+    tcb_sequence s = make_seq();
+    tcb_error err = {0};
+    tcb_atlas_model *m;
+    assert_int_equal(tcb_atlas_model_create(8, 2, &m, &err), TCB_OK);
+    tcb_rng rng;
+    tcb_rng_seed(&rng, 3);
+    tcb_atlas_model_init(m, &rng);
+    for (int mode = 0; mode < 2; mode++) {
+        tcb_atlas_train_cfg cfg = {.loss = TCB_ATLAS_LOSS_CHAMFER, .M = 20, .iterations = 40, .lr = 1e-3,
+                                   .pairs = mode ? TCB_PAIRS_RANDOM : TCB_PAIRS_NEIGHBORS, .delta = 1,
+                                   .divergence = 1e4};
+        tcb_atlas_trainer *t;
+        assert_int_equal(tcb_atlas_trainer_create(&cfg, m, &s, 7, &t, &err), TCB_OK);
+        int far = 0;
+        for (int it = 0; it < 40; it++) {
+            double loss;
+            assert_int_equal(tcb_atlas_train_step(t, &s, &loss, &err), TCB_OK);
+            for (int p = 0; p < TCB_ATLAS_BATCH; p += 2) {
+                int gap = abs(t->frames[p] - t->frames[p + 1]);
+                assert_true(gap >= 1);
+                far += gap > 1;
+            }
+        }
+        if (mode) assert_true(far > 0);
+        else assert_int_equal(far, 0);
+        tcb_atlas_trainer_free(t);
+    }
+    tcb_atlas_train_cfg bad = {.loss = TCB_ATLAS_LOSS_CHAMFER, .M = 20, .iterations = 4, .lr = 1e-3,
+                               .pairs = TCB_PAIRS_WITHIN_SEQ, .delta = 1, .divergence = 1e4};
+    tcb_atlas_trainer *t = NULL;
+    assert_int_equal(tcb_atlas_trainer_create(&bad, m, &s, 7, &t, &err), TCB_ERR_INPUT);
+    void *self = NULL;
+    assert_int_equal(tcb_registry_find("mca")->create("{\"pairs\": \"random\"}", &self, &err), TCB_OK);
+    tcb_registry_find("mca")->destroy(self);
+    tcb_atlas_model_free(m);
+    tcb_sequence_free(&s);
+}
+
 static char *saved(const tcb_method_ops *ops, void *self, const char *dir, const char *name, size_t *len)
 {
     char path[TCB_PATH_MAX], *buf;
@@ -281,7 +324,7 @@ static void test_bad_params(void **state)
     const char *bad[] = {
         "{\"presett\": \"tiny\"}", "{\"preset\": \"huge\"}", "{\"latent\": 0}",
         "{\"patches\": 3, \"uv_samples\": 100}", "{\"iterations\": 0}", "{\"lr\": \"fast\"}",
-        "{\"delta\": 0}", "{\"alpha_mc\": -1}", "[1]",
+        "{\"delta\": 0}", "{\"alpha_mc\": -1}", "{\"pairs\": \"within_seq\"}", "[1]",
     };
     const char *names[] = {"atlasnet", "dsr", "mca"};
     for (int k = 0; k < 3; k++)
@@ -298,6 +341,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_adam_two_steps),
+        cmocka_unit_test(test_pairs_modes),
         cmocka_unit_test(test_lr_schedule),
         cmocka_unit_test(test_loss_decreases),
         cmocka_unit_test(test_methods_fit_eval),
