@@ -11,7 +11,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "tcb/geometry.h"
 #include "tcb/nn.h"
 
 double tcb_align_step_radians(int step) { return 2.0 * M_PI * step / TCB_ALIGN_STEPS; }
@@ -35,14 +34,30 @@ static double mean_d2(const float *d2, int n)
     return s / n;
 }
 
-/* Frame f's sample: `samples` area-uniform points of its surface. */
-static int frame_sample(const tcb_sequence *s, int f, int samples, uint64_t seed, float *out, tcb_error *err)
+/* The same vertex ids in every frame rather than independent surface
+ * samples per frame: two frames' Chamfer then carries no sampling noise of
+ * its own (on crane, independent area samples of 1 000 points drifted up
+ * to 8 steps from those of 10 000 along the sequence; docs/protocol.md D4). */
+int tcb_align_vertex_ids(const tcb_sequence *s, int samples, uint64_t seed, int32_t *ids)
 {
-    char label[TCB_NAME_MAX + 32];
-    snprintf(label, sizeof label, "align/%s/%d", s->name, f);
+    int n = samples < s->n_verts ? samples : s->n_verts;
+    for (int i = 0; i < s->n_verts; i++) ids[i] = i;
+    char label[TCB_NAME_MAX + 16];
+    snprintf(label, sizeof label, "align/%s", s->name);
     tcb_rng rng;
     tcb_rng_seed_stream(&rng, seed, label);
-    return tcb_sample_surface(tcb_seq_frame(s, f), s->faces, s->n_faces, samples, &rng, out, err);
+    for (int i = 0; i < n && n < s->n_verts; i++) {
+        int j = i + (int)tcb_rng_below(&rng, (uint32_t)(s->n_verts - i));
+        int32_t t = ids[i];
+        ids[i] = ids[j], ids[j] = t;
+    }
+    return n;
+}
+
+static void gather(const tcb_sequence *s, int f, const int32_t *ids, int n, float *out)
+{
+    const float *v = tcb_seq_frame(s, f);
+    for (int i = 0; i < n; i++) memcpy(out + 3 * (size_t)i, v + 3 * (size_t)ids[i], 3 * sizeof(float));
 }
 
 typedef struct align_work {
@@ -80,26 +95,28 @@ int tcb_align_yaw(const tcb_sequence *s, int samples, uint64_t seed, int *step, 
 {
     if (samples < 1)
         return tcb_fail(err, TCB_ERR_INPUT, "sequence %s: alignment samples %d must be positive", s->name, samples);
-    size_t n3 = (size_t)samples * 3;
-    align_work w = {samples, malloc(n3 * sizeof(float)), malloc(n3 * sizeof(float)), malloc(n3 * sizeof(float)),
-                    malloc((size_t)samples * sizeof(float)), malloc((size_t)samples * sizeof(int32_t))};
-    int rc = w.cur && w.prev && w.rot && w.d2 && w.idx
-                 ? frame_sample(s, 0, samples, seed, w.prev, err)
+    int32_t *ids = malloc((size_t)s->n_verts * sizeof *ids);
+    int n = ids ? tcb_align_vertex_ids(s, samples, seed, ids) : 0;
+    size_t n3 = (size_t)n * 3;
+    align_work w = {n, malloc(n3 * sizeof(float)), malloc(n3 * sizeof(float)), malloc(n3 * sizeof(float)),
+                    malloc((size_t)n * sizeof(float)), malloc((size_t)n * sizeof(int32_t))};
+    int rc = ids && w.cur && w.prev && w.rot && w.d2 && w.idx
+                 ? TCB_OK
                  : tcb_fail(err, TCB_ERR_NOMEM, "sequence %s: out of memory for the alignment", s->name);
+    if (!rc) gather(s, 0, ids, n, w.prev);
     step[0] = 0;
     if (chamfer) chamfer[0] = 0;
     for (int f = 1; !rc && f < s->n_frames; f++) {
         double cd;
-        rc = frame_sample(s, f, samples, seed, w.cur, err);
-        if (!rc) rc = best_step(&w, &step[f], &cd, err);
-        if (rc) {
+        gather(s, f, ids, n, w.cur);
+        if ((rc = best_step(&w, &step[f], &cd, err))) {
             tcb_error_prefix(err, "sequence %s frame %d: alignment: ", s->name, f);
             break;
         }
         if (chamfer) chamfer[f] = cd;
-        rotate_y(w.prev, w.cur, samples, tcb_align_step_radians(step[f]));
+        rotate_y(w.prev, w.cur, n, tcb_align_step_radians(step[f]));
     }
-    free(w.cur), free(w.prev), free(w.rot), free(w.d2), free(w.idx);
+    free(ids), free(w.cur), free(w.prev), free(w.rot), free(w.d2), free(w.idx);
     return rc;
 }
 

@@ -21,7 +21,7 @@
 #include "tcb/sequence.h"
 
 /* Bump when the layout or the meaning of any field changes. */
-#define CACHE_FORMAT_VERSION 2
+#define CACHE_FORMAT_VERSION 3
 
 /* HDF5 prints its error stack by default; library code must not print, so
  * every entry point silences it and restores the caller's handler after. */

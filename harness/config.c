@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "harness/internal.h"
+#include "tcb/align.h"
 #include "tcb/json.h"
 #include "tcb/synth.h"
 
@@ -21,9 +22,9 @@ static const char *const top_keys[] = {"name", "output", "splits_dir", "cache_di
 static const char *const eval_keys[] = {"pairs", "split_seed", "pool_size", "pool_seed",
                                         "input_points", NULL};
 static const char *const synthetic_keys[] = {"name", "source", "seed", "frames", "normalization",
-                                             "align_rotation", "sampling", "sequences", NULL};
+                                             "align_rotation", "align_samples", "sampling", "sequences", NULL};
 static const char *const objdir_keys[] = {"name", "source", "root", "optional", "normalization",
-                                          "align_rotation", "sampling", "sequences", NULL};
+                                          "align_rotation", "align_samples", "sampling", "sequences", NULL};
 static const char *const sequence_keys[] = {"name", "role", NULL};
 static const char *const method_keys[] = {"name", "method", "params", "seeds", NULL};
 
@@ -160,7 +161,9 @@ static int parse_dataset(const cJSON *o, const char *where, tcb_dataset_spec *d,
     if (!rc)
         rc = tcb_json_enum(o, "normalization", where, 0, TCB_NORM_FIRST_FRAME, tcb_config_norm_names, &norm,
                            err);
+    long long align_samples;
     if (!rc) rc = tcb_json_bool(o, "align_rotation", where, 0, 0, &d->align_rotation, err);
+    if (!rc) rc = tcb_json_int(o, "align_samples", where, 0, TCB_ALIGN_DEFAULT_SAMPLES, 1, 10000000, &align_samples, err);
     if (!rc) rc = tcb_json_enum(o, "sampling", where, 0, 0, tcb_config_sampling_names, &sampling, err);
     if (rc) return rc;
     if (!synthetic && !root[0])
@@ -170,6 +173,7 @@ static int parse_dataset(const cJSON *o, const char *where, tcb_dataset_spec *d,
     d->frames = (int)frames;
     d->norm = (tcb_normalization)norm;
     d->with_replacement = sampling == 1;
+    d->align_samples = d->align_rotation ? (int)align_samples : 0;
     return parse_sequences(o, where, d, err);
 }
 

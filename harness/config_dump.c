@@ -30,6 +30,7 @@ static cJSON *dump_dataset(const tcb_dataset_spec *d)
     }
     cJSON_AddStringToObject(o, "normalization", tcb_config_norm_names[d->norm]);
     cJSON_AddBoolToObject(o, "align_rotation", d->align_rotation);
+    if (d->align_rotation) cJSON_AddNumberToObject(o, "align_samples", d->align_samples);
     cJSON_AddStringToObject(o, "sampling", tcb_config_sampling_names[d->with_replacement != 0]);
     cJSON *seqs = cJSON_AddArrayToObject(o, "sequences");
     for (int k = 0; k < d->n_sequences; k++) {

@@ -13,7 +13,6 @@
 #include <string.h>
 
 #include "harness/internal.h"
-#include "tcb/align.h"
 #include "tcb/fsutil.h"
 #include "tcb/registry.h"
 #include "tcb/synth.h"
@@ -141,7 +140,7 @@ int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, 
 {
     int rc;
     tcb_load_opts lo = {d->norm, cfg->pool_size, cfg->pool_seed, cfg->cache_dir[0] ? cfg->cache_dir : NULL,
-                        d->align_rotation ? TCB_ALIGN_DEFAULT_SAMPLES : 0};
+                        d->align_samples};
     if (d->source == TCB_SOURCE_SYNTHETIC) {
         rc = tcb_synth_generate(name, d->seed, d->frames, seq, err);
         if (!rc) rc = tcb_sequence_prepare(seq, &lo, err);

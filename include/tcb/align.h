@@ -9,8 +9,8 @@
  * the up axis y is tried on the centred frame t, and the one minimising the
  * symmetric Chamfer distance to the already aligned frame t−1 is kept, so
  * the rotations accumulate along the sequence. The distance is computed on
- * a fixed, seeded area-uniform sample of each frame's surface (`samples`
- * points), not on the full clouds, so a sequence aligns in seconds.
+ * a fixed, seeded subset of the vertices (`samples` of them, the same ids
+ * in every frame), not on all of them, so a sequence aligns in seconds.
  *
  * Rotation about y by θ: (x, y, z) → (x cos θ + z sin θ, y, −x sin θ + z cos θ). */
 #ifndef TCB_ALIGN_H
@@ -32,11 +32,16 @@ extern "C" {
  * TCB_NORM_PER_FRAME leaves them): step[f] in 0..TCB_ALIGN_STEPS−1 (the
  * yaw is step · 360° / TCB_ALIGN_STEPS), step[0] = 0; chamfer[f] (NULL:
  * not wanted) the symmetric Chamfer of frame f, rotated, to the aligned
- * frame f−1 on the samples (mean squared distance each way, summed;
- * chamfer[0] = 0). Samples are drawn from (seed, "align/<name>/<f>"). Ties
- * go to the smaller step. */
+ * frame f−1 on the subset (mean squared distance each way, summed;
+ * chamfer[0] = 0). The subset: `samples` distinct vertex ids drawn from
+ * (seed, "align/<name>") by a partial Fisher–Yates shuffle (every vertex
+ * when samples ≥ n_verts). Ties go to the smaller step. */
 int tcb_align_yaw(const tcb_sequence *s, int samples, uint64_t seed, int *step, double *chamfer,
                   tcb_error *err);
+
+/* The subset: ids[0..n) of the returned n = min(samples, n_verts), with
+ * ids [n_verts] (the rest of the permutation follows). */
+int tcb_align_vertex_ids(const tcb_sequence *s, int samples, uint64_t seed, int32_t *ids);
 
 /* Rotates frame f's vertices by step[f] about y and records the yaws
  * (s->yaw, radians). Before the pools are sampled (they are drawn from the

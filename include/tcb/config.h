@@ -13,6 +13,7 @@
  *       { "name": "synth", "source": "synthetic", "seed": 0, "frames": 0,
  *         "normalization": "first_frame" | "none" | "per_frame",
  *         "align_rotation": false,       yaw-align each frame to the previous (AMA; tcb/align.h)
+ *         "align_samples": 1000,         vertices the alignment's Chamfer runs on
  *         "sampling": "without_replacement" | "with_replacement",
  *         "optional": false,             skip (with a message) when root is absent
  *         "root": "../shared/data/anim", objdir sources only: <root>/<sequence>/
@@ -50,6 +51,7 @@ typedef struct tcb_dataset_spec {
     int frames;              /* synthetic: 0 = default length */
     tcb_normalization norm;
     int align_rotation;      /* tcb/align.h after the normalization */
+    int align_samples;       /* its vertex subset; 0 without align_rotation */
     int with_replacement;
     int optional;
     int n_sequences;

@@ -12,7 +12,6 @@
 #include <string.h>
 
 #include "tcb/align.h"
-#include "tcb/geometry.h"
 #include "tcb/sequence.h"
 #include "tcb/synth.h"
 #include "testutil.h"
@@ -36,15 +35,21 @@ static void turned_walk(tcb_sequence *s)
     s->yaw = NULL;
 }
 
+/* The turned walk aligned with the subset seed `seed`. */
+static void align_turned(tcb_sequence *s, uint64_t seed, int *step, double *cd)
+{
+    turned_walk(s);
+    tcb_error err = {0};
+    assert_int_equal(tcb_align_yaw(s, SAMPLES, seed, step, cd, &err), TCB_OK);
+}
+
 static void test_recovers_known_turns(void **state)
 {
     (void)state;
     tcb_sequence s;
-    turned_walk(&s);
     int step[FRAMES];
     double cd[FRAMES];
-    tcb_error err = {0};
-    assert_int_equal(tcb_align_yaw(&s, SAMPLES, 5, step, cd, &err), TCB_OK);
+    align_turned(&s, 5, step, cd);
     for (int f = 0; f < FRAMES; f++) assert_int_equal(step[f], turn[f]);
     assert_true(cd[0] == 0.0);
     for (int f = 1; f < FRAMES; f++) assert_true(cd[f] > 0.0 && isfinite(cd[f]));
@@ -77,16 +82,13 @@ static double brute_chamfer(const float *a, const float *b, int n, double theta)
     return there / n + back / n;
 }
 
-/* The same samples as tcb_align_yaw draws: its documented stream. */
+/* The subset tcb_align_yaw measures on, of frame f. */
 static void sample_frame(const tcb_sequence *s, int f, uint64_t seed, float *out)
 {
-    char label[TCB_NAME_MAX + 32];
-    snprintf(label, sizeof label, "align/%s/%d", s->name, f);
-    tcb_rng rng;
-    tcb_rng_seed_stream(&rng, seed, label);
-    tcb_error err = {0};
-    assert_int_equal(tcb_sample_surface(tcb_seq_frame(s, f), s->faces, s->n_faces, SAMPLES, &rng, out, &err),
-                     TCB_OK);
+    int32_t *ids = malloc((size_t)s->n_verts * sizeof *ids);
+    assert_int_equal(tcb_align_vertex_ids(s, SAMPLES, seed, ids), SAMPLES);
+    for (int i = 0; i < SAMPLES; i++) memcpy(out + 3 * i, tcb_seq_frame(s, f) + 3 * ids[i], 3 * sizeof(float));
+    free(ids);
 }
 
 static void rotate(float *p, int n, double theta)
@@ -102,11 +104,9 @@ static void test_chamfer_is_the_brute_force_minimum(void **state)
 {
     (void)state;
     tcb_sequence s;
-    turned_walk(&s);
     int step[FRAMES];
     double cd[FRAMES];
-    tcb_error err = {0};
-    assert_int_equal(tcb_align_yaw(&s, SAMPLES, 9, step, cd, &err), TCB_OK);
+    align_turned(&s, 9, step, cd);
     float *prev = tu_falloc(3 * SAMPLES), *cur = tu_falloc(3 * SAMPLES);
     sample_frame(&s, 0, 9, prev);
     for (int f = 1; f < 3; f++) {

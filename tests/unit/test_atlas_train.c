@@ -180,17 +180,25 @@ static void test_methods_fit_eval(void **state)
     tcb_sequence_free(&s);
 }
 
+/* C 8, P 2, initialised from seed 3. */
+static tcb_atlas_model *small_model(void)
+{
+    tcb_atlas_model *m;
+    tcb_error err = {0};
+    assert_int_equal(tcb_atlas_model_create(8, 2, &m, &err), TCB_OK);
+    tcb_rng rng;
+    tcb_rng_seed(&rng, 3);
+    tcb_atlas_model_init(m, &rng);
+    return m;
+}
+
 /* A NaN weight stops training with TCB_ERR_NUMERIC naming the iteration. */
 static void test_nan_is_numeric(void **state)
 {
     (void)state;
     tcb_sequence s = make_seq();
     tcb_error err = {0};
-    tcb_atlas_model *m;
-    assert_int_equal(tcb_atlas_model_create(8, 2, &m, &err), TCB_OK);
-    tcb_rng rng;
-    tcb_rng_seed(&rng, 3);
-    tcb_atlas_model_init(m, &rng);
+    tcb_atlas_model *m = small_model();
     tcb_atlas_train_cfg cfg = {.loss = TCB_ATLAS_LOSS_CHAMFER, .M = 20, .iterations = 10, .lr = 1e-3,
                                .delta = 1, .divergence = 1e4};
     tcb_atlas_trainer *t;
@@ -212,11 +220,7 @@ static void test_pairs_modes(void **state)
     (void)state;
     tcb_sequence s = make_seq();
     tcb_error err = {0};
-    tcb_atlas_model *m;
-    assert_int_equal(tcb_atlas_model_create(8, 2, &m, &err), TCB_OK);
-    tcb_rng rng;
-    tcb_rng_seed(&rng, 3);
-    tcb_atlas_model_init(m, &rng);
+    tcb_atlas_model *m = small_model();
     for (int mode = 0; mode < 2; mode++) {
         tcb_atlas_train_cfg cfg = {.loss = TCB_ATLAS_LOSS_CHAMFER, .M = 20, .iterations = 40, .lr = 1e-3,
                                    .pairs = mode ? TCB_PAIRS_RANDOM : TCB_PAIRS_NEIGHBORS, .delta = 1,
