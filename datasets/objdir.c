@@ -159,6 +159,23 @@ int tcb_objdir_default_name(const char *dir, char name[TCB_NAME_MAX], tcb_error 
     return TCB_OK;
 }
 
+int tcb_sequence_probe_objdir(const char *dir, int *n_frames, int *n_verts, tcb_error *err)
+{
+    tcb_objdir_frame *frames;
+    int n;
+    *n_frames = *n_verts = 0;
+    int rc = tcb_objdir_list(dir, &frames, &n, err);
+    if (rc) return rc;
+    char path[TCB_PATH_MAX];
+    tcb_mesh m = {0};
+    rc = tcb_path_join(path, sizeof path, err, "%s/%s", dir, frames[0].name);
+    if (!rc) rc = tcb_obj_read(path, &m, err);
+    if (!rc) *n_frames = n, *n_verts = m.n_verts;
+    tcb_mesh_free(&m);
+    free(frames);
+    return rc;
+}
+
 int tcb_sequence_read_objdir(const char *dir, tcb_sequence *out, tcb_error *err)
 {
     memset(out, 0, sizeof *out);

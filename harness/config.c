@@ -18,7 +18,8 @@
 
 static const char *const top_keys[] = {"name", "output", "splits_dir", "cache_dir", "plugins",
                                        "seeds", "threads", "evaluation", "datasets", "methods",
-                                       NULL};
+                                       "reference", NULL};
+static const char *const reference_keys[] = {"source", "tables", NULL};
 static const char *const eval_keys[] = {"pairs", "split_seed", "pool_size", "pool_seed",
                                         "input_points", NULL};
 static const char *const synthetic_keys[] = {"name", "source", "seed", "frames", "normalization",
@@ -26,7 +27,7 @@ static const char *const synthetic_keys[] = {"name", "source", "seed", "frames",
 static const char *const objdir_keys[] = {"name", "source", "root", "optional", "normalization",
                                           "align_rotation", "align_samples", "sampling", "sequences", NULL};
 static const char *const sequence_keys[] = {"name", "role", NULL};
-static const char *const method_keys[] = {"name", "method", "params", "seeds", NULL};
+static const char *const method_keys[] = {"name", "method", "params", "seeds", "datasets", NULL};
 
 const char *const tcb_config_source_names[] = {"synthetic", "objdir", NULL};
 const char *const tcb_config_norm_names[] = {"none", "first_frame", "per_frame", NULL};
@@ -155,7 +156,7 @@ static int parse_dataset(const cJSON *o, const char *where, tcb_dataset_spec *d,
     if (!rc) rc = check_name(name, sizeof d->name, where, "name", err);
     if (!rc) rc = tcb_json_int(o, "seed", where, 0, 0, 0, LLONG_MAX, &seed, err);
     if (!rc) rc = tcb_json_int(o, "frames", where, 0, 0, 0, 100000, &frames, err);
-    if (!rc) rc = tcb_json_str(o, "root", where, !synthetic, "", &root, err);
+    if (!rc) rc = tcb_json_str(o, "root", where, 0, "", &root, err);
     if (!rc) rc = copy_str(d->root, sizeof d->root, root, where, "root", err);
     if (!rc) rc = tcb_json_bool(o, "optional", where, 0, 0, &d->optional, err);
     if (!rc)
@@ -166,8 +167,6 @@ static int parse_dataset(const cJSON *o, const char *where, tcb_dataset_spec *d,
     if (!rc) rc = tcb_json_int(o, "align_samples", where, 0, TCB_ALIGN_DEFAULT_SAMPLES, 1, 10000000, &align_samples, err);
     if (!rc) rc = tcb_json_enum(o, "sampling", where, 0, 0, tcb_config_sampling_names, &sampling, err);
     if (rc) return rc;
-    if (!synthetic && !root[0])
-        return tcb_fail(err, TCB_ERR_INPUT, "%s.root: must not be empty", where);
     snprintf(d->name, sizeof d->name, "%s", name);
     d->seed = (uint64_t)seed;
     d->frames = (int)frames;
@@ -221,6 +220,40 @@ static int parse_method_seeds(const cJSON *o, const char *where, const tcb_confi
     return TCB_OK;
 }
 
+/* "datasets": names of the config's datasets, each once. */
+static int parse_method_datasets(const cJSON *o, const char *where, const tcb_config *c, tcb_method_spec *m,
+                                 tcb_error *err)
+{
+    const cJSON *arr;
+    int rc = get_array(o, "datasets", where, 0, &arr, err);
+    if (rc || !arr) return rc;
+    int n = cJSON_GetArraySize(arr);
+    if (n == 0) return tcb_fail(err, TCB_ERR_INPUT, "%s.datasets: must list at least one dataset", where);
+    m->only_on = calloc((size_t)n, sizeof *m->only_on);
+    if (!m->only_on) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", where);
+    for (int k = 0; k < n; k++) {
+        const cJSON *d = cJSON_GetArrayItem(arr, k);
+        int known = 0;
+        for (int j = 0; cJSON_IsString(d) && j < c->n_datasets; j++)
+            known |= strcmp(c->datasets[j].name, d->valuestring) == 0;
+        if (!known)
+            return tcb_fail(err, TCB_ERR_INPUT, "%s.datasets[%d]: expected the name of one of the config's datasets",
+                            where, k);
+        if (tcb_method_runs_on(m, d->valuestring) && m->n_only_on)
+            return tcb_fail(err, TCB_ERR_INPUT, "%s.datasets[%d]: duplicate dataset '%s'", where, k, d->valuestring);
+        snprintf(m->only_on[k], sizeof m->only_on[k], "%s", d->valuestring);
+        m->n_only_on = k + 1;
+    }
+    return TCB_OK;
+}
+
+int tcb_method_runs_on(const tcb_method_spec *m, const char *dataset)
+{
+    for (int k = 0; k < m->n_only_on; k++)
+        if (strcmp(m->only_on[k], dataset) == 0) return 1;
+    return m->n_only_on == 0;
+}
+
 static int parse_method(const cJSON *o, const char *where, const tcb_config *c,
                         tcb_method_spec *m, tcb_error *err)
 {
@@ -239,7 +272,8 @@ static int parse_method(const cJSON *o, const char *where, const tcb_config *c,
     /* The method itself validates the keys when it is created. */
     m->params_json = params ? cJSON_PrintUnformatted(params) : strdup("{}");
     if (!m->params_json) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", where);
-    return parse_method_seeds(o, where, c, m, err);
+    rc = parse_method_seeds(o, where, c, m, err);
+    return rc ? rc : parse_method_datasets(o, where, c, m, err);
 }
 
 static int parse_datasets(const cJSON *root, const char *origin, tcb_config *c, tcb_error *err)
@@ -388,7 +422,42 @@ static int parse_scalars(const cJSON *root, const char *origin, tcb_config *c, t
     return TCB_OK;
 }
 
+/* "reference": { "source": "iccv21", "tables": ["5", "7"] } */
+static int parse_reference(const cJSON *root, const char *origin, tcb_config *c, tcb_error *err)
+{
+    char w[WHERE_MAX];
+    snprintf(w, sizeof w, "%s: reference", origin);
+    const cJSON *ref = cJSON_GetObjectItemCaseSensitive(root, "reference");
+    if (!ref) return TCB_OK;
+    const char *source;
+    const cJSON *tables;
+    int rc = tcb_json_expect_keys(ref, w, reference_keys, err);
+    if (!rc) rc = tcb_json_str(ref, "source", w, 1, NULL, &source, err);
+    if (!rc) rc = check_name(source, sizeof c->reference, w, "source", err);
+    if (!rc) rc = get_array(ref, "tables", w, 1, &tables, err);
+    if (rc) return rc;
+    int n = cJSON_GetArraySize(tables);
+    if (n < 1 || n > TCB_REFERENCE_TABLES_MAX)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.tables: must list 1 to %d tables", w, TCB_REFERENCE_TABLES_MAX);
+    for (int k = 0; k < n; k++) {
+        const cJSON *t = cJSON_GetArrayItem(tables, k);
+        if (!cJSON_IsString(t) || !t->valuestring[0] || strlen(t->valuestring) >= sizeof c->reference_tables[k])
+            return tcb_fail(err, TCB_ERR_INPUT, "%s.tables[%d]: expected a table id of 1 to %zu characters", w, k,
+                            sizeof c->reference_tables[k] - 1);
+        snprintf(c->reference_tables[k], sizeof c->reference_tables[k], "%s", t->valuestring);
+    }
+    snprintf(c->reference, sizeof c->reference, "%s", source);
+    c->n_reference_tables = n;
+    return TCB_OK;
+}
+
 int tcb_config_parse(const char *text, const char *origin, tcb_config *out, tcb_error *err)
+{
+    return tcb_config_parse_opts(text, origin, NULL, out, err);
+}
+
+int tcb_config_parse_opts(const char *text, const char *origin, const tcb_config_opts *opts,
+                          tcb_config *out, tcb_error *err)
 {
     memset(out, 0, sizeof *out);
     if (strlen(origin) >= sizeof out->path)
@@ -400,6 +469,7 @@ int tcb_config_parse(const char *text, const char *origin, tcb_config *out, tcb_
     char top[WHERE_MAX];
     snprintf(top, sizeof top, "%s:", origin);
     rc = tcb_json_expect_object(root, origin, err);
+    if (!rc) rc = tcb_config_apply_opts(root, origin, opts, err);
     if (!rc) rc = fix_top(tcb_json_expect_keys(root, top, top_keys, err), origin, err);
     if (!rc) rc = parse_scalars(root, origin, out, err);
     if (!rc) rc = parse_plugins(root, origin, out, err);
@@ -407,6 +477,7 @@ int tcb_config_parse(const char *text, const char *origin, tcb_config *out, tcb_
     if (!rc) rc = parse_evaluation(root, origin, out, err);
     if (!rc) rc = parse_datasets(root, origin, out, err);
     if (!rc) rc = parse_methods(root, origin, out, err);
+    if (!rc) rc = parse_reference(root, origin, out, err);
     cJSON_Delete(root);
     if (!rc) {
         out->json_text = tcb_config_normalized_json(out);
@@ -418,11 +489,17 @@ int tcb_config_parse(const char *text, const char *origin, tcb_config *out, tcb_
 
 int tcb_config_load(const char *path, tcb_config *out, tcb_error *err)
 {
+    return tcb_config_load_opts(path, NULL, out, err);
+}
+
+int tcb_config_load_opts(const char *path, const tcb_config_opts *opts, tcb_config *out,
+                         tcb_error *err)
+{
     memset(out, 0, sizeof *out);
     char *text;
     int rc = tcb_read_file(path, &text, NULL, err);
     if (rc) return rc;
-    rc = tcb_config_parse(text, path, out, err);
+    rc = tcb_config_parse_opts(text, path, opts, out, err);
     free(text);
     return rc;
 }
@@ -438,6 +515,7 @@ void tcb_config_free(tcb_config *c)
     for (int k = 0; k < c->n_methods; k++) {
         free(c->methods[k].params_json);
         free(c->methods[k].seeds);
+        free(c->methods[k].only_on);
     }
     free(c->methods);
     free(c->json_text);

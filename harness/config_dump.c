@@ -59,6 +59,10 @@ static cJSON *dump_method(const tcb_method_spec *m, const tcb_config *c)
     int own = m->n_seeds != c->n_seeds ||
               memcmp(m->seeds, c->seeds, (size_t)c->n_seeds * sizeof *c->seeds) != 0;
     if (own) cJSON_AddItemToObject(o, "seeds", seed_array(m->seeds, m->n_seeds));
+    if (m->n_only_on) {
+        cJSON *on = cJSON_AddArrayToObject(o, "datasets");
+        for (int k = 0; k < m->n_only_on; k++) cJSON_AddItemToArray(on, cJSON_CreateString(m->only_on[k]));
+    }
     return o;
 }
 
@@ -81,6 +85,13 @@ char *tcb_config_normalized_json(const tcb_config *c)
         cJSON_AddItemToArray(datasets, dump_dataset(&c->datasets[k]));
     cJSON *methods = cJSON_AddArrayToObject(o, "methods");
     for (int k = 0; k < c->n_methods; k++) cJSON_AddItemToArray(methods, dump_method(&c->methods[k], c));
+    if (c->reference[0]) {
+        cJSON *ref = cJSON_AddObjectToObject(o, "reference");
+        cJSON_AddStringToObject(ref, "source", c->reference);
+        cJSON *tables = cJSON_AddArrayToObject(ref, "tables");
+        for (int k = 0; k < c->n_reference_tables; k++)
+            cJSON_AddItemToArray(tables, cJSON_CreateString(c->reference_tables[k]));
+    }
     char *text = cJSON_Print(o);
     cJSON_Delete(o);
     return text;

@@ -5,10 +5,13 @@
 
 #include <stddef.h>
 
+#include <cjson/cJSON.h>
+
 #include "tcb/config.h"
 #include "tcb/method.h"
 #include "tcb/metrics.h"
 #include "tcb/results.h"
+#include "tcb/runner.h"
 #include "tcb/sequence.h"
 #include "tcb/split.h"
 
@@ -20,6 +23,20 @@ extern const char *const tcb_config_sampling_names[]; /* with_replacement: 0, 1 
 /* The config with every default filled in, pretty-printed; malloc'ed, NULL
  * when out of memory. (harness/config_dump.c) */
 char *tcb_config_normalized_json(const tcb_config *c);
+
+/* The chosen variant and the roots applied to a config's JSON tree before
+ * it is read (harness/config_overlay.c). */
+int tcb_config_apply_opts(cJSON *root, const char *origin, const tcb_config_opts *o, tcb_error *err);
+
+/* Pieces of the runner the dry run shares (harness/runner.c): */
+/* the method is the one --only names, or every method without --only; */
+int tcb_run_selected(const tcb_run_opts *opts, const tcb_method_spec *m);
+/* every selected method exists and accepts its params; */
+int tcb_run_check_methods(const tcb_config *cfg, const tcb_run_opts *opts, tcb_error *err);
+/* d's data cannot be read: no root, or no such directory; */
+int tcb_run_root_missing(const tcb_dataset_spec *d);
+/* why: "no root given (--root NAME=DIR or TCBENCH_ROOT_NAME)" or "<root> not found". */
+void tcb_run_missing_root_text(const tcb_dataset_spec *d, char *out, size_t size);
 
 /* Short git revision of the source tree tcbench was built from, or
  * "unknown". (harness/sysinfo.c) */

@@ -17,7 +17,8 @@
 
 enum {
     F_OUT, F_ONLY, F_FORCE, F_QUIET, F_REPORT, F_SEED, F_FRAMES, F_SEQUENCE, F_UPDATE,
-    F_PLUGIN, F_THREADS, F_VERBOSE, F_SAMPLES, F_PLOT, F_HELP, F_COUNT
+    F_PLUGIN, F_THREADS, F_VERBOSE, F_SAMPLES, F_PLOT, F_ROOT, F_VARIANT, F_DRY_RUN, F_REFERENCE, F_HELP,
+    F_COUNT
 };
 #define BIT(f) (1u << (f))
 
@@ -29,10 +30,13 @@ static const struct {
     [F_QUIET] = {"--quiet", 0},  [F_REPORT] = {"--report", 0},   [F_SEED] = {"--seed", 1},
     [F_FRAMES] = {"--frames", 1}, [F_SEQUENCE] = {"--sequence", 1}, [F_UPDATE] = {"--update", 0},
     [F_PLUGIN] = {"--plugin", 1}, [F_THREADS] = {"--threads", 1}, [F_VERBOSE] = {"--verbose", 0},
-    [F_SAMPLES] = {"--samples", 1}, [F_PLOT] = {"--plot", 1}, [F_HELP] = {"--help", 0},
+    [F_SAMPLES] = {"--samples", 1}, [F_PLOT] = {"--plot", 1}, [F_ROOT] = {"--root", 1},
+    [F_VARIANT] = {"--variant", 1}, [F_DRY_RUN] = {"--dry-run", 0}, [F_REFERENCE] = {"--reference", 1},
+    [F_HELP] = {"--help", 0},
 };
 
 #define MAX_PLUGINS 64
+#define MAX_ROOTS 16
 #define MAX_ARGS 4
 
 typedef struct cli {
@@ -42,6 +46,9 @@ typedef struct cli {
     int set[F_COUNT];            /* flag given */
     const char *plugins[MAX_PLUGINS];
     int n_plugins;
+    tcb_root_override roots[MAX_ROOTS]; /* --root NAME=DIR; dataset points into root_names */
+    char root_names[MAX_ROOTS][64];
+    int n_roots;
 } cli;
 
 typedef struct command {
@@ -97,8 +104,15 @@ static int cmd_run(const cli *c)
     tcb_config cfg;
     long long threads;
     if (int_option(c, F_THREADS, 0, &threads)) return 2;
-    if (tcb_config_load(c->arg[0], &cfg, &err)) return fail(&err);
+    tcb_config_opts co = {c->value[F_VARIANT], c->n_roots, c->roots};
+    if (tcb_config_load_opts(c->arg[0], &co, &cfg, &err)) return fail(&err);
     if (threads > 0) cfg.threads = (int)(threads > 1024 ? 1024 : threads);
+    if (c->set[F_DRY_RUN]) {
+        tcb_run_opts dry = {c->value[F_OUT], c->value[F_ONLY], c->set[F_FORCE], {0}};
+        int rc = tcb_run_dry(&cfg, &dry, stdout, &err);
+        tcb_config_free(&cfg);
+        return rc ? fail(&err) : 0;
+    }
     tcb_term_progress tp;
     tcb_term_progress_init(&tp, stderr, c->set[F_QUIET] ? 1 : -1);
     tp.verbose = c->set[F_VERBOSE];
@@ -274,16 +288,23 @@ static int cmd_help(const cli *c);
 
 static const command commands[] = {
     {"run", cmd_run,
-     BIT(F_OUT) | BIT(F_ONLY) | BIT(F_FORCE) | BIT(F_QUIET) | BIT(F_REPORT) | BIT(F_THREADS) | BIT(F_VERBOSE), 1, 1,
-     "CONFIG",
-     "usage: tcbench run CONFIG [--out DIR] [--only METHOD] [--threads N] [--force] [--quiet]\n"
-     "                  [--verbose] [--report] [--plugin SO]...\n"
+     BIT(F_OUT) | BIT(F_ONLY) | BIT(F_FORCE) | BIT(F_QUIET) | BIT(F_REPORT) | BIT(F_THREADS) | BIT(F_VERBOSE) |
+         BIT(F_ROOT) | BIT(F_VARIANT) | BIT(F_DRY_RUN),
+     1, 1, "CONFIG",
+     "usage: tcbench run CONFIG [--root DATASET=DIR]... [--variant NAME] [--dry-run] [--out DIR]\n"
+     "                  [--only METHOD] [--threads N] [--force] [--quiet] [--verbose] [--report]\n"
+     "                  [--plugin SO]...\n"
      "\n"
      "Runs every (dataset, sequence, method, seed) cell of the config and writes one\n"
      "result file per cell. Finished cells are skipped, so rerunning a killed run\n"
      "resumes it.\n"
      "\n"
      "options:\n"
+     "  --root D=DIR   the data of the config's dataset D (else $TCBENCH_ROOT_<D>, else the\n"
+     "                 config's \"root\"); repeatable\n"
+     "  --variant NAME the config's variant (configs/paper/*: cpu, the default, or paper);\n"
+     "                 the run goes to <output>/<variant>\n"
+     "  --dry-run      list the cells, their state and an estimate of their compute; run nothing\n"
      "  --out DIR      run directory (default: the config's \"output\")\n"
      "  --only METHOD  run only the method with this label\n"
      "  --threads N    threads per cell (default: the config's \"threads\", else 2); two\n"
@@ -294,8 +315,17 @@ static const command commands[] = {
      "  --report       write the report when the run is done\n"
      "  --plugin SO    load out-of-tree methods from a shared object (repeatable)\n"
      "\n"
-     "example:\n"
-     "  tcbench run configs/quick.json --out runs/quick --report\n"},
+     "the paper's datasets (configs/paper/*; docs/datasets.md says how to lay them out):\n"
+     "  anim    Sumner & Popovic 2004, \"Deformation transfer for triangle meshes\": the\n"
+     "          cat, horse, camel and elephant sequences, one OBJ directory each\n"
+     "  ama     Vlasic et al. 2008, \"Articulated mesh animation from multi-view\n"
+     "          silhouettes\": crane, bouncing, ... one OBJ directory each\n"
+     "  dfaust  Bogo et al. 2017, Dynamic FAUST: registrations_m.hdf5 and\n"
+     "          registrations_f.hdf5 in one directory\n"
+     "\n"
+     "examples:\n"
+     "  tcbench run configs/quick.json --out runs/quick --report\n"
+     "  tcbench run configs/paper/table5-nricp.json --root ama=../shared/data/ama --dry-run\n"},
     {"report", cmd_report, BIT(F_OUT) | BIT(F_QUIET), 1, 1, "RUN_DIR",
      "usage: tcbench report RUN_DIR [--out DIR] [--quiet]\n"
      "\n"
@@ -463,6 +493,17 @@ static int parse_flag(const command *cmd, int argc, char **argv, int *i, cli *c)
     if (f == F_PLUGIN) {
         if (c->n_plugins == MAX_PLUGINS) return usage_error(where, "too many %s options", name);
         c->plugins[c->n_plugins++] = value;
+    }
+    if (f == F_ROOT) {
+        const char *sep = strchr(value, '=');
+        size_t n = sep ? (size_t)(sep - value) : 0;
+        if (!sep || !n || !sep[1] || n >= sizeof c->root_names[0])
+            return usage_error(where, "--root: expected DATASET=DIR, got '%s'", value);
+        if (c->n_roots == MAX_ROOTS) return usage_error(where, "too many %s options", name);
+        memcpy(c->root_names[c->n_roots], value, n);
+        c->root_names[c->n_roots][n] = '\0';
+        c->roots[c->n_roots] = (tcb_root_override){c->root_names[c->n_roots], sep + 1};
+        c->n_roots++;
     }
     c->set[f] = 1;
     c->value[f] = value;

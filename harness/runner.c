@@ -80,21 +80,21 @@ static const tcb_method_spec *find_label(const tcb_config *cfg, const char *labe
     return NULL;
 }
 
-static int selected(const tcb_run_opts *opts, const tcb_method_spec *m)
+int tcb_run_selected(const tcb_run_opts *opts, const tcb_method_spec *m)
 {
     return !opts->only_method || strcmp(opts->only_method, m->label) == 0;
 }
 
 /* Every selected method must exist and accept its params before any work
  * starts: a typo should cost seconds, not the hours of the cells before it. */
-static int check_methods(const tcb_config *cfg, const tcb_run_opts *opts, tcb_error *err)
+int tcb_run_check_methods(const tcb_config *cfg, const tcb_run_opts *opts, tcb_error *err)
 {
     if (opts->only_method && !find_label(cfg, opts->only_method))
         return tcb_fail(err, TCB_ERR_INPUT, "--only: %s has no method labelled '%s'", cfg->path,
                         opts->only_method);
     for (int k = 0; k < cfg->n_methods; k++) {
         const tcb_method_spec *m = &cfg->methods[k];
-        if (!selected(opts, m)) continue;
+        if (!tcb_run_selected(opts, m)) continue;
         const tcb_method_ops *ops = tcb_registry_find(m->method);
         if (!ops) {
             char list[1024] = "";
@@ -266,7 +266,7 @@ static int run_cells(const run_state *st, const seq_ctx *sc, tcb_error *err)
     const tcb_config *cfg = st->cfg;
     for (int k = 0; k < cfg->n_methods; k++) {
         const tcb_method_spec *m = &cfg->methods[k];
-        if (!selected(st->opts, m)) continue;
+        if (!tcb_run_selected(st->opts, m) || !tcb_method_runs_on(m, sc->dataset->name)) continue;
         for (int s = 0; s < m->n_seeds; s++) {
             char path[TCB_PATH_MAX];
             int rc = tcb_cell_path(path, sizeof path, st->run_dir, sc->dataset->name,
@@ -303,18 +303,32 @@ static int run_sequence(const run_state *st, const tcb_dataset_spec *d, const tc
     return rc;
 }
 
-static int root_missing(const tcb_dataset_spec *d)
+int tcb_run_root_missing(const tcb_dataset_spec *d)
 {
     return d->source == TCB_SOURCE_OBJDIR && !tcb_is_dir(d->root);
+}
+
+void tcb_run_missing_root_text(const tcb_dataset_spec *d, char *out, size_t size)
+{
+    char var[128];
+    tcb_config_root_env_name(d->name, var, sizeof var);
+    if (d->root[0]) snprintf(out, size, "%s not found", d->root);
+    else snprintf(out, size, "no root given (--root %s=DIR or %s)", d->name, var);
 }
 
 /* Missing data is found before any cell runs, not hours into the run. */
 static int check_roots(const tcb_config *cfg, tcb_error *err)
 {
     for (int k = 0; k < cfg->n_datasets; k++)
-        if (!cfg->datasets[k].optional && root_missing(&cfg->datasets[k]))
-            return tcb_fail(err, TCB_ERR_IO, "%s: datasets[%d].root: %s: no such directory",
-                            cfg->path, k, cfg->datasets[k].root);
+        if (!cfg->datasets[k].optional && tcb_run_root_missing(&cfg->datasets[k])) {
+            const tcb_dataset_spec *d = &cfg->datasets[k];
+            char why[TCB_PATH_MAX + 64];
+            tcb_run_missing_root_text(d, why, sizeof why);
+            if (d->root[0])
+                return tcb_fail(err, TCB_ERR_IO, "%s: datasets[%d].root: %s: no such directory",
+                                cfg->path, k, d->root);
+            return tcb_fail(err, TCB_ERR_INPUT, "%s: datasets[%d] (%s): %s", cfg->path, k, d->name, why);
+        }
     return TCB_OK;
 }
 
@@ -324,17 +338,18 @@ int tcb_run(const tcb_config *cfg, const tcb_run_opts *opts, tcb_run_stats *stat
     memset(stats, 0, sizeof *stats);
     run_state st = {cfg, opts, opts->output ? opts->output : cfg->output, "", stats};
     int rc = tcb_harness_load_plugins(cfg, err);
-    if (!rc) rc = check_methods(cfg, opts, err);
+    if (!rc) rc = tcb_run_check_methods(cfg, opts, err);
     if (!rc) rc = check_roots(cfg, err);
     if (!rc) rc = write_config(&st, err);
     if (rc) return rc;
     tcb_git_revision(st.git_revision, sizeof st.git_revision);
     for (int k = 0; k < cfg->n_datasets && !rc; k++) {
         const tcb_dataset_spec *d = &cfg->datasets[k];
-        if (root_missing(d)) {
+        if (tcb_run_root_missing(d)) {
             /* A warning, not info: a silently shorter table would mislead. */
-            tcb_report_log(&opts->reporter, TCB_LOG_WARN,
-                           "dataset %s skipped: %s not found (optional)", d->name, d->root);
+            char why[TCB_PATH_MAX + 64];
+            tcb_run_missing_root_text(d, why, sizeof why);
+            tcb_report_log(&opts->reporter, TCB_LOG_WARN, "dataset %s skipped: %s (optional)", d->name, why);
             continue;
         }
         for (int s = 0; s < d->n_sequences && !rc; s++)

@@ -65,9 +65,10 @@ static int valid_name(const char *name)
 static int check_table(const tcb_method_ops *ops, const char *path, tcb_error *err)
 {
     if (!ops) return tcb_fail(err, TCB_ERR_INPUT, "%s: plug-in returned a NULL method table", path);
-    if (ops->abi_version != TCB_METHOD_ABI_VERSION)
-        return tcb_fail(err, TCB_ERR_INPUT, "%s: method ABI version %d, this tcbench needs %d (rebuild the plug-in)",
-                        path, ops->abi_version, TCB_METHOD_ABI_VERSION);
+    if (ops->abi_version < TCB_METHOD_ABI_OLDEST || ops->abi_version > TCB_METHOD_ABI_VERSION)
+        return tcb_fail(err, TCB_ERR_INPUT,
+                        "%s: method ABI version %d, this tcbench reads %d to %d (rebuild the plug-in)", path,
+                        ops->abi_version, TCB_METHOD_ABI_OLDEST, TCB_METHOD_ABI_VERSION);
     if (!valid_name(ops->name))
         return tcb_fail(err, TCB_ERR_INPUT, "%s: method name '%s' must be 1-63 characters of [a-z0-9_-]", path,
                         ops->name ? ops->name : "(null)");

@@ -7,6 +7,12 @@
  *     "plugins": ["path/lib.so"],        optional out-of-tree methods
  *     "seeds": [0],
  *     "threads": 2,
+ *     "reference": { "source": "iccv21", "tables": ["5"] },   the paper's tables
+ *                                        this config reproduces (tcbench report --reference)
+ *     "variants": { "cpu": { "seeds": [0], "params": { "mca": { "preset": "cpu" } } },
+ *                   "paper": { … } },    chosen with --variant (default: the first);
+ *                                        "params" merge into the methods with that label
+ *                                        or method name; the run goes to <output>/<variant>
  *     "evaluation": { "pairs": 500, "split_seed": 2021, "pool_size": 10000,
  *                     "pool_seed": 0, "input_points": 2500 },
  *     "datasets": [
@@ -16,15 +22,19 @@
  *         "align_samples": 1000,         vertices the alignment's Chamfer runs on
  *         "sampling": "without_replacement" | "with_replacement",
  *         "optional": false,             skip (with a message) when root is absent
- *         "root": "../shared/data/anim", objdir sources only: <root>/<sequence>/
+ *         "root": "../shared/data/anim", objdir sources only: <root>/<sequence>/; may be
+ *                                        left out and given as --root NAME=DIR or in the
+ *                                        environment as TCBENCH_ROOT_<NAME>
  *         "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
  *     "methods": [ { "name": "oracle" },
  *                  { "name": "mca-cpu", "method": "mca", "params": { … },
- *                    "seeds": [0, 1, 2] } ] }    its own seeds instead of the config's
+ *                    "seeds": [0, 1, 2],          its own seeds instead of the config's
+ *                    "datasets": ["dfaust"] } ] } only on these datasets (default: all)
  * Unknown keys anywhere are errors. */
 #ifndef TCB_CONFIG_H
 #define TCB_CONFIG_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "tcb/error.h"
@@ -64,7 +74,14 @@ typedef struct tcb_method_spec {
     char *params_json;       /* compact JSON object text, "{}" by default */
     int n_seeds;             /* the cells to run: the method's "seeds", else the config's */
     int *seeds;
+    int n_only_on;           /* "datasets": the datasets it runs on; 0: all of them */
+    char (*only_on)[64];
 } tcb_method_spec;
+
+/* Whether method m has cells on the dataset named `dataset`. */
+int tcb_method_runs_on(const tcb_method_spec *m, const char *dataset);
+
+#define TCB_REFERENCE_TABLES_MAX 16
 
 typedef struct tcb_config {
     char path[TCB_PATH_MAX];
@@ -86,11 +103,34 @@ typedef struct tcb_config {
     tcb_dataset_spec *datasets;
     int n_methods;
     tcb_method_spec *methods;
+    char reference[32];      /* "reference.source"; "" when the config names none */
+    int n_reference_tables;
+    char reference_tables[TCB_REFERENCE_TABLES_MAX][16];
     char *json_text;         /* the normalized config, saved beside the results */
 } tcb_config;
 
+/* What the command line changes before the config is read. */
+typedef struct tcb_root_override {
+    const char *dataset;     /* a dataset's "name" */
+    const char *dir;         /* its root */
+} tcb_root_override;
+
+typedef struct tcb_config_opts {
+    const char *variant;     /* NULL: the config's first variant, if it has any */
+    int n_roots;
+    const tcb_root_override *roots;
+} tcb_config_opts;
+
 int tcb_config_load(const char *path, tcb_config *out, tcb_error *err);
 int tcb_config_parse(const char *text, const char *origin, tcb_config *out, tcb_error *err);
+/* The same with the command line's choices; opts NULL is as above: the
+ * first variant, roots from the environment or the config. */
+int tcb_config_load_opts(const char *path, const tcb_config_opts *opts, tcb_config *out,
+                         tcb_error *err);
+int tcb_config_parse_opts(const char *text, const char *origin, const tcb_config_opts *opts,
+                          tcb_config *out, tcb_error *err);
+/* "TCBENCH_ROOT_<NAME>" for dataset `name`. */
+void tcb_config_root_env_name(const char *dataset, char *out, size_t size);
 void tcb_config_free(tcb_config *c);
 
 #ifdef __cplusplus

@@ -37,7 +37,9 @@
 extern "C" {
 #endif
 
-#define TCB_METHOD_ABI_VERSION 1
+/* 2 added `estimate`; tables of version 1 still load (without it). */
+#define TCB_METHOD_ABI_VERSION 2
+#define TCB_METHOD_ABI_OLDEST 1
 
 typedef struct tcb_fit_ctx {
     uint64_t seed;          /* the cell's seed */
@@ -52,6 +54,21 @@ typedef struct tcb_fit_ctx {
                              * the cell's fit_s counts the whole fit. Appended
                              * last: tables built before it ignore it */
 } tcb_fit_ctx;
+
+/* What `tcbench run --dry-run` knows of a cell before running it. */
+typedef struct tcb_cost_query {
+    int n_frames, n_verts;  /* the sequence's; 0 when its data are absent */
+    int n_pairs;            /* evaluation pairs */
+    int n_threads;          /* threads of the cell */
+} tcb_cost_query;
+
+/* Seconds of wall time on the machine the method's step costs were measured
+ * on (say which in `basis`); negative: unknown (for example a cost that
+ * grows with the vertex count when the data are absent). */
+typedef struct tcb_cost_estimate {
+    double fit_s, eval_s;
+    char basis[200];        /* "40 000 steps x 63.5 ms (bench_train_step, 1 thread)" */
+} tcb_cost_estimate;
 
 typedef struct tcb_method_ops {
     int abi_version;            /* TCB_METHOD_ABI_VERSION */
@@ -82,6 +99,11 @@ typedef struct tcb_method_ops {
     int (*load)(void *self, const tcb_sequence *seq, const char *path, tcb_error *err);
 
     void (*destroy)(void *self);
+
+    /* Optional (NULL: "no estimate"; read only from tables of abi_version
+     * >= 2). The compute a cell of this configured method will take, from
+     * the method's known step costs; called on a created, unfitted self. */
+    void (*estimate)(void *self, const tcb_cost_query *q, tcb_cost_estimate *out);
 } tcb_method_ops;
 
 typedef const tcb_method_ops *const *(*tcb_plugin_entry_fn)(int *count);

@@ -7,6 +7,8 @@
 #ifndef TCB_RUNNER_H
 #define TCB_RUNNER_H
 
+#include <stdio.h>
+
 #include "tcb/config.h"
 #include "tcb/error.h"
 #include "tcb/progress.h"
@@ -28,6 +30,12 @@ typedef struct tcb_run_stats {
 
 int tcb_run(const tcb_config *cfg, const tcb_run_opts *opts, tcb_run_stats *stats,
             tcb_error *err);
+
+/* The dry run: prints to `out` every cell (numbered in grid order over the
+ * whole config), its state in the run directory and the compute it would
+ * take, from each method's step costs; loads plug-ins and checks the
+ * methods as tcb_run does, and runs nothing. */
+int tcb_run_dry(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_error *err);
 
 #ifdef __cplusplus
 }

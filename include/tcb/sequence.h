@@ -68,6 +68,10 @@ static inline const float *tcb_seq_pool(const tcb_sequence *s, int f)
  * frame are an error naming both files. Fewer than two frames is an error. */
 int tcb_sequence_read_objdir(const char *dir, tcb_sequence *out, tcb_error *err);
 
+/* The frame count and the first frame's vertex count of an OBJ directory,
+ * reading one file: what a dry run needs to size the work. */
+int tcb_sequence_probe_objdir(const char *dir, int *n_frames, int *n_verts, tcb_error *err);
+
 /* Allocate an empty sequence with the given sizes (verts/faces uninitialised). */
 int tcb_sequence_alloc(tcb_sequence *s, const char *name, int n_frames, int n_verts,
                        int n_faces, tcb_error *err);

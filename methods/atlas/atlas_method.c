@@ -20,6 +20,7 @@
 #include "methods/atlas/train_ckpt.h"
 #include "methods/builtin.h"
 #include "methods/params.h"
+#include "methods/step_cost.h"
 #include "neural/train_loop.h"
 #include "tcb/json.h"
 #include "tcb/metrics.h"
@@ -39,6 +40,7 @@ static const char *const pair_names[] = {"neighbors", "random", NULL};     /* tr
 
 typedef struct atlas_method {
     const char *name;           /* the method's, for messages */
+    int preset;                 /* presets[preset]; -1 when a size differs from it */
     int C, P;
     tcb_atlas_train_cfg cfg;
     long long checkpoint_every; /* iterations between training checkpoints; 0: none */
@@ -81,6 +83,7 @@ static int parse(const char *params_json, const char *where, atlas_method *a, tc
         return tcb_fail(err, TCB_ERR_INPUT, "%s: uv_samples %lld must be a multiple of patches %lld", where, M,
                         P);
     a->C = (int)C, a->P = (int)P;
+    a->preset = C == pr->C && P == pr->P && M == pr->M ? pi : -1;
     c->M = (int)M, c->iterations = it, c->delta = (int)delta;
     c->pairs = pairs ? TCB_PAIRS_RANDOM : TCB_PAIRS_NEIGHBORS;
     return TCB_OK;
@@ -272,6 +275,27 @@ static int load(void *self, const tcb_sequence *seq, const char *path, tcb_error
     return rc;
 }
 
+/* Seconds per training step, bench_train_step on 2 Zen 4 cores, idle
+ * (docs/protocol.md, the preset table); 0: not measured. */
+static const tcb_step_cost step_costs[][3] = {
+    /*            atlasnet                     dsr                          mca */
+    [0] = {{0, 0.30, "Zen 4"}, {0, 0, "Zen 4"}, {0, 0.72, "Zen 4"}},           /* paper */
+    [1] = {{0.0408, 0.0247, "Zen 4"}, {0, 0.0356, "Zen 4"}, {0.0635, 0.0352, "Zen 4"}}, /* cpu */
+};
+/* An evaluation pair: two forward passes, the collapse test and the
+ * nearest-neighbour transfer; measured on the cat at the cpu preset. */
+#define EVAL_PAIR_S 0.02
+
+static void estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out)
+{
+    const atlas_method *a = self;
+    int loss = a->cfg.loss == TCB_ATLAS_LOSS_CHAMFER ? 0 : a->cfg.loss == TCB_ATLAS_LOSS_DSR ? 1 : 2;
+    int measured = a->preset == 0 || a->preset == 1;
+    tcb_step_cost_estimate(measured ? &step_costs[a->preset][loss] : NULL, a->cfg.iterations, EVAL_PAIR_S, q,
+                           measured ? NULL : "no step cost measured for these sizes (preset tiny or overridden)",
+                           out);
+}
+
 /* ---- the three tables ---------------------------------------------------- */
 
 #define ATLAS_METHOD(id, loss, desc)                                                                         \
@@ -282,7 +306,7 @@ static int load(void *self, const tcb_sequence *seq, const char *path, tcb_error
     const tcb_method_ops tcb_method_##id = {                                                                 \
         .abi_version = TCB_METHOD_ABI_VERSION, .name = #id, .description = desc, .create = id##_create,      \
         .fit = fit, .transfer = transfer, .reconstruct = reconstruct, .save = save, .load = load,            \
-        .destroy = destroy,                                                                                  \
+        .destroy = destroy, .estimate = estimate,                                                            \
     };
 
 ATLAS_METHOD(atlasnet, TCB_ATLAS_LOSS_CHAMFER, "AtlasNet: PointNet + patch decoders, Chamfer loss only")

@@ -29,4 +29,5 @@ const tcb_method_ops tcb_method_nearest = {
     .fit = tcb_stateless_fit,
     .transfer = nearest_transfer,
     .destroy = tcb_stateless_destroy,
+    .estimate = tcb_stateless_estimate,
 };

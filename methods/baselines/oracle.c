@@ -33,4 +33,5 @@ const tcb_method_ops tcb_method_oracle = {
     .fit = tcb_stateless_fit,
     .transfer = oracle_transfer,
     .destroy = tcb_stateless_destroy,
+    .estimate = tcb_stateless_estimate,
 };

@@ -1,5 +1,7 @@
 #include "methods/baselines/stateless.h"
 
+#include <stdio.h>
+
 #include "methods/params.h"
 
 int tcb_stateless_create(const char *where, const char *params_json, void **self, tcb_error *err)
@@ -19,3 +21,10 @@ int tcb_stateless_fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ct
 }
 
 void tcb_stateless_destroy(void *self) { (void)self; }
+
+void tcb_stateless_estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out)
+{
+    (void)self, (void)q;
+    out->fit_s = out->eval_s = 0;
+    snprintf(out->basis, sizeof out->basis, "no model");
+}

@@ -9,5 +9,7 @@
 int tcb_stateless_create(const char *where, const char *params_json, void **self, tcb_error *err);
 int tcb_stateless_fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_error *err);
 void tcb_stateless_destroy(void *self);
+/* Nothing to fit, nothing per pair beyond the harness's own projection. */
+void tcb_stateless_estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out);
 
 #endif

@@ -38,6 +38,7 @@
 #include "methods/cycle/train.h"
 #include "methods/cycle/train_ckpt.h"
 #include "methods/params.h"
+#include "methods/step_cost.h"
 #include "neural/train_loop.h"
 #include "neural/weights.h"
 #include "tcb/json.h"
@@ -59,6 +60,7 @@ static const char *const sampling_names[] = {"random", "knn", "neighbors", NULL}
 static const char *const readout_names[] = {"clouds", "vertices", NULL};
 
 typedef struct cc_method {
+    int preset;                 /* presets[preset]; -1 when a size differs from it */
     tcb_cc_dims d;
     tcb_cc_train_cfg cfg;
     int points;                 /* per training cloud; 0: the dataset's input_points */
@@ -93,6 +95,9 @@ static int parse_numbers(const cJSON *j, const char *where, const cc_preset *pr,
     if (!rc) rc = tcb_json_num(j, "divergence", where, 0, 1e4, 0, 1e300, &t->divergence, err);
     if (rc) return rc;
     c->d = (tcb_cc_dims){(int)C, (int)Z, (int)H, (int)L, residual};
+    int same = C == pr->d.C && Z == pr->d.Z && H == pr->d.H && L == pr->d.L && batch == pr->batch &&
+               points == pr->points;
+    c->preset = same ? (int)(pr - presets) : -1;
     t->batch = (int)batch, t->iterations = it, c->points = (int)points;
     t->warmup = (long long)(c->warmup * (double)it + 0.5);
     t->sampler.delta = (int)delta, t->sampler.knn_k = (int)knn;
@@ -311,6 +316,25 @@ static int load(void *self, const tcb_sequence *seq, const char *path, tcb_error
     return rc;
 }
 
+/* Seconds per training step, bench_train_step --method cc on 2 Zen 4
+ * cores, idle (docs/protocol.md); 0: not measured. */
+static const tcb_step_cost step_costs[] = {
+    {0, 4.5, "Zen 4"},        /* paper */
+    {0.1799, 0.1195, "Zen 4"}, /* cpu */
+};
+/* An evaluation pair (two encodings, the deformation of frame i's vertices):
+ * 3.6 s for the cat's 500 pairs at the cpu preset. */
+#define EVAL_PAIR_S 0.0072
+
+static void estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out)
+{
+    const cc_method *c = self;
+    int measured = c->preset == 0 || c->preset == 1;
+    tcb_step_cost_estimate(measured ? &step_costs[c->preset] : NULL, c->cfg.iterations, EVAL_PAIR_S, q,
+                           measured ? NULL : "no step cost measured for these sizes (preset short, tiny or overridden)",
+                           out);
+}
+
 const tcb_method_ops tcb_method_cc = {
     .abi_version = TCB_METHOD_ABI_VERSION,
     .name = "cc",
@@ -322,4 +346,5 @@ const tcb_method_ops tcb_method_cc = {
     .save = save,
     .load = load,
     .destroy = destroy,
+    .estimate = estimate,
 };

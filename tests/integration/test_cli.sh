@@ -3,24 +3,11 @@
 # naming the offending word), datasets, methods, run, report and check.
 set -euo pipefail
 : "${TCBENCH:?}"
+. "$(dirname "${BASH_SOURCE[0]}")/expect.sh"
 
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cd "$tmp"
-
-# expect STATUS TEXT CMD...: CMD exits with STATUS and, when TEXT is not
-# empty, prints TEXT on stdout or stderr.
-expect() {
-    local want=$1 text=$2 rc=0
-    shift 2
-    "$@" > out.txt 2> err.txt || rc=$?
-    if [ "$rc" -ne "$want" ]; then
-        echo "FAIL: '$*' exited $rc, expected $want"; cat out.txt err.txt; exit 1
-    fi
-    if [ -n "$text" ] && ! grep -qF -- "$text" out.txt err.txt; then
-        echo "FAIL: '$*' did not print '$text'"; cat out.txt err.txt; exit 1
-    fi
-}
 
 # ---- help and usage errors
 for cmd in run report methods datasets check version help; do

@@ -4,19 +4,11 @@
 # "align_rotation": true runs on them, and bad input is a clear error.
 set -euo pipefail
 : "${TCBENCH:?}"
+. "$(dirname "${BASH_SOURCE[0]}")/expect.sh"
 
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cd "$tmp"
-
-expect() { # STATUS TEXT CMD...
-    local want=$1 text=$2 rc=0
-    shift 2
-    "$@" > out.txt 2> err.txt || rc=$?
-    [ "$rc" -eq "$want" ] || { echo "FAIL: '$*' exited $rc, expected $want"; cat out.txt err.txt; exit 1; }
-    [ -z "$text" ] || grep -qF -- "$text" out.txt err.txt ||
-        { echo "FAIL: '$*' did not print '$text'"; cat out.txt err.txt; exit 1; }
-}
 
 # A synthetic walk whose frame f is turned about y by -steps[f] x 3 degrees.
 "$TCBENCH" datasets synth --out raw --sequence quadruped_walk --frames 6 2> /dev/null
