@@ -141,6 +141,12 @@ static int cmd_report(const cli *c)
 {
     tcb_error err = {0};
     const char *out = c->value[F_OUT];
+    if (c->value[F_REFERENCE]) {
+        FILE *echo = c->set[F_QUIET] ? NULL : stdout;
+        if (tcb_report_reference(c->arg[0], c->value[F_REFERENCE], out, echo, &err)) return fail(&err);
+        fprintf(stderr, "report: %s/reference_*.{md,tex,csv}\n", out ? out : c->arg[0]);
+        return 0;
+    }
     if (tcb_report_write(c->arg[0], out, c->set[F_QUIET] ? NULL : stdout, &err)) return fail(&err);
     if (out) fprintf(stderr, "report: %s/\n", out);
     else fprintf(stderr, "report: %s/report/\n", c->arg[0]);
@@ -326,19 +332,28 @@ static const command commands[] = {
      "examples:\n"
      "  tcbench run configs/quick.json --out runs/quick --report\n"
      "  tcbench run configs/paper/table5-nricp.json --root ama=../shared/data/ama --dry-run\n"},
-    {"report", cmd_report, BIT(F_OUT) | BIT(F_QUIET), 1, 1, "RUN_DIR",
-     "usage: tcbench report RUN_DIR [--out DIR] [--quiet]\n"
+    {"report", cmd_report, BIT(F_OUT) | BIT(F_QUIET) | BIT(F_REFERENCE), 1, 1, "RUN_DIR",
+     "usage: tcbench report RUN_DIR [--reference NAME] [--out DIR] [--quiet]\n"
      "\n"
      "Writes tables.md, tables.tex, results.csv, by_gap.csv, and per sequence the PCK\n"
      "curves and m_sL2 by frame distance as PNG plots, for a run directory, and\n"
      "prints the Markdown tables.\n"
      "\n"
-     "options:\n"
-     "  --out DIR  where to write (default: RUN_DIR/report)\n"
-     "  --quiet    do not print the tables\n"
+     "With --reference: the run's tables beside the paper's instead, in the paper's\n"
+     "shape: ours, the paper's value and ours/paper per cell, and per metric whether\n"
+     "the methods come out in the paper's order (reference_NAME.md, .tex, .csv). The\n"
+     "tables are those the run's config names (\"reference\"), else every table\n"
+     "naming one of the run's cells.\n"
      "\n"
-     "example:\n"
-     "  tcbench report runs/quick\n"},
+     "options:\n"
+     "  --reference NAME  iccv21 (built in: every table of the ICCV'21 paper and its\n"
+     "                    supplement) or a tcbench-reference/1 file\n"
+     "  --out DIR         where to write (default: RUN_DIR/report)\n"
+     "  --quiet           do not print the tables\n"
+     "\n"
+     "examples:\n"
+     "  tcbench report runs/quick\n"
+     "  tcbench report runs/paper/table5-nricp/cpu --reference iccv21\n"},
     {"methods", cmd_methods, 0, 0, 0, "",
      "usage: tcbench methods [--plugin SO]...\n"
      "\n"

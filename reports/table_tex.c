@@ -4,8 +4,7 @@
 
 #include "reports/writers.h"
 
-/* Names come from configs; escape what LaTeX would read as markup. */
-static void put_escaped(FILE *f, const char *s)
+void tcb_rpt_tex_escaped(FILE *f, const char *s)
 {
     for (; *s; s++) {
         switch (*s) {
@@ -24,9 +23,9 @@ static void write_block(FILE *f, const tcb_rpt_block *b, const char *title)
 {
     for (int k = 0; k < b->n_rows; k++) {
         const tcb_rpt_row *r = &b->rows[k];
-        if (k == 0) put_escaped(f, title);
+        if (k == 0) tcb_rpt_tex_escaped(f, title);
         fputs(" & ", f);
-        put_escaped(f, r->method);
+        tcb_rpt_tex_escaped(f, r->method);
         for (int m = 0; m < TCB_N_METRICS; m++) {
             char cell[128];
             tcb_rpt_cell_text(r, m, " $\\pm$ ", cell, sizeof cell);
@@ -44,7 +43,7 @@ static void write_block(FILE *f, const tcb_rpt_block *b, const char *title)
 static void write_dataset(FILE *f, const tcb_rpt *r, const tcb_rpt_dataset *d)
 {
     fputs("\\begin{table}[t]\n\\centering\n\\caption{", f);
-    put_escaped(f, d->name);
+    tcb_rpt_tex_escaped(f, d->name);
     fputs(": m\\_sL2 $\\times 10^{3}$, rank \\%, AUC \\%, CD $\\times 10^{3}$ (mean $\\pm$ std); "
           "best in bold, ``-'': no reconstruction. MEAN: over the test sequences.}\n"
           "\\begin{tabular}{llcccc}\n\\toprule\nSequence & Method",

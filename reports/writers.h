@@ -12,6 +12,8 @@
 void tcb_rpt_write_md(FILE *f, const tcb_rpt *r);   /* reports/table_md.c */
 void tcb_rpt_write_tex(FILE *f, const tcb_rpt *r);  /* reports/table_tex.c */
 void tcb_rpt_write_csv(FILE *f, const tcb_rpt *r);  /* reports/table_csv.c */
+/* Names come from configs; escapes what LaTeX would read as markup. (reports/table_tex.c) */
+void tcb_rpt_tex_escaped(FILE *f, const char *s);
 /* by_gap.csv: each sequence row's m_sL2 per frame distance. (reports/table_csv.c) */
 void tcb_rpt_write_gap_csv(FILE *f, const tcb_rpt *r);
 /* seeds.csv: each cell's own means. (reports/table_csv.c) */

@@ -22,6 +22,16 @@ extern "C" {
  * echoes the Markdown tables to `echo` if non-NULL. */
 int tcb_report_write(const char *run_dir, const char *out_dir, FILE *echo, tcb_error *err);
 
+/* Our tables beside a reference's (the paper's numbers: `reference` is a
+ * built-in name, "iccv21", or a tcbench-reference/1 file): the tables the
+ * run's config names under "reference", else every table naming one of its
+ * cells, in the paper's shape with ours, the paper's and ours/paper per
+ * value and whether the methods' order agrees; writes
+ * <out_dir>/reference_<name>.{md,tex,csv} (out_dir NULL: <run>/report) and
+ * echoes the Markdown to `echo` if non-NULL. */
+int tcb_report_reference(const char *run_dir, const char *reference, const char *out_dir, FILE *echo,
+                         tcb_error *err);
+
 /* Baseline file "tcbench-baseline/1": per (dataset, sequence, method) the four
  * metrics in table units, plus per-metric tolerances. */
 int tcb_baseline_write(const char *run_dir, const char *baseline_path, tcb_error *err);

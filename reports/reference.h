@@ -1,0 +1,95 @@
+/* Private to reports/: published numbers to set a run beside
+ * (tcbench-reference/1, references/<name>.json, compiled into the library).
+ *
+ * A reference is a list of tables; each row is one number of the paper
+ * with the table and row it came from and the cell of ours it compares
+ * with: (dataset, sequence, method label), sequence "MEAN" for a dataset
+ * mean row. Values are in table units (tcb_rpt_metrics) as [mean, std]. */
+#ifndef TCB_REPORTS_REFERENCE_H
+#define TCB_REPORTS_REFERENCE_H
+
+#include "reports/aggregate.h"
+#include "tcb/error.h"
+
+#define TCB_REFERENCE_FORMAT "tcbench-reference/1"
+
+typedef struct tcb_ref_row {
+    char paper_row[96];            /* "AMA crane, delta 3": how the paper names it */
+    char dataset[64], sequence[128], method[64];
+    int has[TCB_N_METRICS];        /* 0: the paper gives no value */
+    int has_std[TCB_N_METRICS];
+    double mean[TCB_N_METRICS], std[TCB_N_METRICS];
+} tcb_ref_row;
+
+typedef struct tcb_ref_table {
+    char id[16];                   /* "5" */
+    char title[160];
+    int n_rows;
+    tcb_ref_row *rows;
+} tcb_ref_table;
+
+typedef struct tcb_reference {
+    char name[32];
+    char paper[320];
+    int n_tables;
+    tcb_ref_table *tables;
+} tcb_reference;
+
+/* `name` is a built-in reference ("iccv21") or the path of a file in the
+ * format; errors name the file (or the built-in) and the key. */
+int tcb_reference_load(const char *name, tcb_reference *out, tcb_error *err);
+int tcb_reference_parse(const char *text, const char *origin, tcb_reference *out, tcb_error *err);
+const tcb_ref_table *tcb_reference_table(const tcb_reference *r, const char *id);
+void tcb_reference_free(tcb_reference *r);
+
+/* The built-in references: NULL-terminated names and their JSON text
+ * (reports/reference_builtin.c, generated from references/ by the build). */
+extern const char *const tcb_reference_builtin_names[];
+extern const char *const tcb_reference_builtin_texts[];
+
+/* ---- a run beside a reference (reports/reference_compare.c) ---------- */
+
+/* One row of a reference table and our cell for it (NULL: not run). */
+typedef struct tcb_ref_cmp_row {
+    const tcb_ref_row *paper;
+    const tcb_rpt_row *ours;
+} tcb_ref_cmp_row;
+
+/* Rows of one (dataset, sequence) of a table: the methods the paper
+ * compares there, in its order. */
+typedef struct tcb_ref_group {
+    const char *dataset, *sequence;
+    int n_rows, n_ours;              /* n_ours: rows with a cell of ours */
+    tcb_ref_cmp_row *rows;
+} tcb_ref_group;
+
+typedef struct tcb_ref_cmp_table {
+    const tcb_ref_table *table;
+    int shown[TCB_N_METRICS];        /* metrics the paper reports in this table */
+    int n_groups;
+    tcb_ref_group *groups;           /* only groups with at least one cell of ours */
+    int n_absent;                    /* groups the run has no cell of */
+} tcb_ref_cmp_table;
+
+typedef struct tcb_ref_cmp {
+    const tcb_reference *ref;
+    int n_tables;
+    tcb_ref_cmp_table *tables;
+} tcb_ref_cmp;
+
+/* The tables `ids` of ref (n_ids 0: every table naming a cell of the run)
+ * set beside run r; an unknown id is an error. */
+int tcb_ref_compare(const tcb_reference *ref, const tcb_rpt *r, const char (*ids)[16], int n_ids, tcb_ref_cmp *out,
+                    tcb_error *err);
+void tcb_ref_cmp_free(tcb_ref_cmp *c);
+
+/* How the methods of a group are ordered by metric m, here and in the
+ * paper: *n_pairs compared pairs of rows (both with values), *n_flips of
+ * them ordered the other way round; the first flip in a/b (indices into
+ * g->rows, a better in the paper), -1 when none. */
+void tcb_ref_ordering(const tcb_ref_group *g, int m, int *n_pairs, int *n_flips, int *a, int *b);
+
+/* ours / paper of metric m's means; NaN when either is missing or the paper's is 0. */
+double tcb_ref_ratio(const tcb_ref_cmp_row *row, int m);
+
+#endif

@@ -1,0 +1,227 @@
+/* `tcbench report RUN --reference NAME`: each reference table the run
+ * reproduces, in the paper's shape, our value beside the paper's and
+ * ours/paper per cell, with a line per metric saying whether the methods
+ * come out in the paper's order; as Markdown, LaTeX (booktabs) and CSV. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "reports/reference.h"
+#include "reports/writers.h"
+#include "tcb/config.h"
+#include "tcb/fsutil.h"
+#include "tcb/json.h"
+#include "tcb/report.h"
+
+static void ours_text(const tcb_ref_cmp_row *row, int m, const char *pm, char *out, size_t size)
+{
+    if (!row->ours) snprintf(out, size, "not run");
+    else tcb_rpt_cell_text(row->ours, m, pm, out, size);
+}
+
+static void paper_text(const tcb_ref_row *p, int m, const char *pm, char *out, size_t size)
+{
+    int d = tcb_rpt_metrics[m].decimals;
+    if (!p->has[m]) snprintf(out, size, "-");
+    else if (!p->has_std[m]) snprintf(out, size, "%.*f", d, p->mean[m]);
+    else snprintf(out, size, "%.*f%s%.*f", d, p->mean[m], pm, d, p->std[m]);
+}
+
+static void ratio_text(const tcb_ref_cmp_row *row, int m, char *out, size_t size)
+{
+    double q = tcb_ref_ratio(row, m);
+    if (!isnan(q)) snprintf(out, size, "%.2f", q);
+    else snprintf(out, size, "-");
+}
+
+/* "m_sL2: same order (3 pairs)" or "rank: 1 of 3 pairs flipped, e.g. ..." */
+static void ordering_text(const tcb_ref_group *g, int m, char *out, size_t size)
+{
+    int n, flips, a, b;
+    tcb_ref_ordering(g, m, &n, &flips, &a, &b);
+    const char *name = tcb_rpt_metrics[m].label;
+    if (!n) snprintf(out, size, "%s: nothing to order", name);
+    else if (!flips) snprintf(out, size, "%s: agrees (%d pair%s)", name, n, n == 1 ? "" : "s");
+    else
+        snprintf(out, size, "%s: flips %d of %d pairs, e.g. the paper has %s better than %s, this run the reverse",
+                 name, flips, n, g->rows[a].paper->paper_row, g->rows[b].paper->paper_row);
+}
+
+/* ---- Markdown ---------------------------------------------------------- */
+
+static void md_group(FILE *f, const tcb_ref_cmp_table *t, const tcb_ref_group *g)
+{
+    fprintf(f, "\n**%s / %s**\n\n| paper row | cell |", g->dataset, g->sequence);
+    for (int m = 0; m < TCB_N_METRICS; m++)
+        if (t->shown[m]) fprintf(f, " %s ours | paper | ours/paper |", tcb_rpt_metrics[m].label);
+    fprintf(f, "\n|:---|:---|");
+    for (int m = 0; m < TCB_N_METRICS; m++)
+        if (t->shown[m]) fprintf(f, "---:|---:|---:|");
+    fprintf(f, "\n");
+    for (int k = 0; k < g->n_rows; k++) {
+        const tcb_ref_cmp_row *row = &g->rows[k];
+        fprintf(f, "| %s | %s |", row->paper->paper_row, row->paper->method);
+        for (int m = 0; m < TCB_N_METRICS; m++) {
+            if (!t->shown[m]) continue;
+            char o[96], p[96], q[32];
+            ours_text(row, m, " ± ", o, sizeof o);
+            paper_text(row->paper, m, " ± ", p, sizeof p);
+            ratio_text(row, m, q, sizeof q);
+            fprintf(f, " %s | %s | %s |", o, p, q);
+        }
+        fprintf(f, "\n");
+    }
+    fprintf(f, "\nThe order of the rows, here and in the paper:\n\n");
+    for (int m = 0; m < TCB_N_METRICS; m++) {
+        char line[512];
+        if (!t->shown[m]) continue;
+        ordering_text(g, m, line, sizeof line);
+        fprintf(f, "- %s\n", line);
+    }
+}
+
+static void write_md(FILE *f, const tcb_ref_cmp *c)
+{
+    fprintf(f, "# Beside the paper: %s\n\n%s\n", c->ref->name, c->ref->paper);
+    for (int k = 0; k < c->n_tables; k++) {
+        const tcb_ref_cmp_table *t = &c->tables[k];
+        fprintf(f, "\n## %s\n", t->table->title);
+        for (int g = 0; g < t->n_groups; g++) md_group(f, t, &t->groups[g]);
+        if (t->n_absent) fprintf(f, "\n%d more group%s of this table not in the run.\n", t->n_absent,
+                                 t->n_absent == 1 ? "" : "s");
+    }
+}
+
+/* ---- LaTeX ------------------------------------------------------------- */
+
+static void tex_group(FILE *f, const tcb_ref_cmp_table *t, const tcb_ref_group *g)
+{
+    int cols = 0;
+    for (int m = 0; m < TCB_N_METRICS; m++) cols += t->shown[m];
+    fputs("\\begin{table}[t]\n\\centering\n\\caption{", f);
+    tcb_rpt_tex_escaped(f, t->table->title);
+    fputs(": ", f);
+    tcb_rpt_tex_escaped(f, g->dataset);
+    fputs("/", f);
+    tcb_rpt_tex_escaped(f, g->sequence);
+    fputs(". Each cell: ours / paper (ours$/$paper).}\n\\begin{tabular}{l", f);
+    for (int k = 0; k < cols; k++) fputs("c", f);
+    fputs("}\n\\toprule\nRow", f);
+    for (int m = 0; m < TCB_N_METRICS; m++)
+        if (t->shown[m]) fprintf(f, " & %s", tcb_rpt_metrics[m].tex_label);
+    fputs(" \\\\\n\\midrule\n", f);
+    for (int k = 0; k < g->n_rows; k++) {
+        const tcb_ref_cmp_row *row = &g->rows[k];
+        tcb_rpt_tex_escaped(f, row->paper->paper_row);
+        for (int m = 0; m < TCB_N_METRICS; m++) {
+            if (!t->shown[m]) continue;
+            char o[96], p[96], q[32];
+            ours_text(row, m, " $\\pm$ ", o, sizeof o);
+            paper_text(row->paper, m, " $\\pm$ ", p, sizeof p);
+            ratio_text(row, m, q, sizeof q);
+            fprintf(f, " & %s / %s (%s)", o, p, q);
+        }
+        fputs(" \\\\\n", f);
+    }
+    fputs("\\bottomrule\n\\end{tabular}\n\\end{table}\n\n", f);
+}
+
+static void write_tex(FILE *f, const tcb_ref_cmp *c)
+{
+    fputs("% tcbench beside the paper; needs \\usepackage{booktabs}.\n\n", f);
+    for (int k = 0; k < c->n_tables; k++)
+        for (int g = 0; g < c->tables[k].n_groups; g++) tex_group(f, &c->tables[k], &c->tables[k].groups[g]);
+}
+
+/* ---- CSV --------------------------------------------------------------- */
+
+static void csv_value(FILE *f, int has, double v)
+{
+    if (has) fprintf(f, ",%.6g", v);
+    else fputs(",", f);
+}
+
+static void write_csv(FILE *f, const tcb_ref_cmp *c)
+{
+    fputs("table,dataset,sequence,paper_row,method,metric,ours_mean,ours_std,paper_mean,paper_std,ratio,status\n", f);
+    for (int k = 0; k < c->n_tables; k++)
+        for (int g = 0; g < c->tables[k].n_groups; g++) {
+            const tcb_ref_group *gr = &c->tables[k].groups[g];
+            for (int r = 0; r < gr->n_rows; r++)
+                for (int m = 0; m < TCB_N_METRICS; m++) {
+                    const tcb_ref_cmp_row *row = &gr->rows[r];
+                    if (!c->tables[k].shown[m]) continue;
+                    int ok = row->ours && !strcmp(row->ours->status, "ok") && row->ours->has[m];
+                    fprintf(f, "%s,%s,%s,\"%s\",%s,%s", c->tables[k].table->id, gr->dataset, gr->sequence,
+                            row->paper->paper_row, row->paper->method, tcb_rpt_metrics[m].key);
+                    csv_value(f, ok, ok ? row->ours->mean[m] : 0);
+                    csv_value(f, ok, ok ? row->ours->std[m] : 0);
+                    csv_value(f, row->paper->has[m], row->paper->mean[m]);
+                    csv_value(f, row->paper->has_std[m], row->paper->std[m]);
+                    csv_value(f, !isnan(tcb_ref_ratio(row, m)), tcb_ref_ratio(row, m));
+                    fprintf(f, ",%s\n", row->ours ? row->ours->status : "not run");
+                }
+        }
+}
+
+/* ---- the command ------------------------------------------------------- */
+
+/* The tables the run's config says it reproduces of reference `name`
+ * (<run>/config.json "reference"); 0 when it names none of it. */
+static int config_tables(const char *run_dir, const char *name, char (*ids)[16], tcb_error *err)
+{
+    char path[TCB_PATH_MAX];
+    cJSON *cfg = NULL;
+    if (tcb_path_join(path, sizeof path, err, "%s/config.json", run_dir) || !tcb_is_file(path) ||
+        tcb_json_load(path, &cfg, err))
+        return 0; /* a run without its config: every table naming its cells */
+    const cJSON *ref = cJSON_GetObjectItemCaseSensitive(cfg, "reference");
+    const cJSON *src = cJSON_GetObjectItemCaseSensitive(ref, "source");
+    const cJSON *tables = cJSON_GetObjectItemCaseSensitive(ref, "tables"), *t;
+    int n = 0;
+    if (cJSON_IsString(src) && !strcmp(src->valuestring, name))
+        cJSON_ArrayForEach(t, tables) if (cJSON_IsString(t) && n < TCB_REFERENCE_TABLES_MAX)
+            snprintf(ids[n++], sizeof ids[0], "%s", t->valuestring);
+    cJSON_Delete(cfg);
+    return n;
+}
+
+typedef void (*cmp_writer)(FILE *f, const tcb_ref_cmp *c);
+
+static int write_one(const char *dir, const char *name, const char *ext, cmp_writer w, const tcb_ref_cmp *c,
+                     tcb_error *err)
+{
+    char path[TCB_PATH_MAX];
+    tcb_atomic_file af;
+    int rc = tcb_path_join(path, sizeof path, err, "%s/reference_%s.%s", dir, name, ext);
+    if (rc || (rc = tcb_atomic_open(&af, path, err))) return rc;
+    w(af.fp, c);
+    return tcb_atomic_commit(&af, err);
+}
+
+int tcb_report_reference(const char *run_dir, const char *reference, const char *out_dir, FILE *echo,
+                         tcb_error *err)
+{
+    char dir[TCB_PATH_MAX], ids[TCB_REFERENCE_TABLES_MAX][16];
+    int rc = out_dir ? tcb_path_join(dir, sizeof dir, err, "%s", out_dir)
+                     : tcb_path_join(dir, sizeof dir, err, "%s/report", run_dir);
+    tcb_reference ref;
+    if (rc || (rc = tcb_reference_load(reference, &ref, err))) return rc;
+    tcb_rpt r;
+    if ((rc = tcb_rpt_load(run_dir, &r, err))) {
+        tcb_reference_free(&ref);
+        return rc;
+    }
+    tcb_ref_cmp c = {0};
+    int n_ids = config_tables(run_dir, ref.name, ids, err);
+    rc = tcb_ref_compare(&ref, &r, (const char(*)[16])ids, n_ids, &c, err);
+    if (!rc) rc = tcb_mkdirs(dir, err);
+    if (!rc) rc = write_one(dir, ref.name, "md", write_md, &c, err);
+    if (!rc) rc = write_one(dir, ref.name, "tex", write_tex, &c, err);
+    if (!rc) rc = write_one(dir, ref.name, "csv", write_csv, &c, err);
+    if (!rc && echo) write_md(echo, &c);
+    if (c.tables) tcb_ref_cmp_free(&c);
+    tcb_rpt_free(&r);
+    tcb_reference_free(&ref);
+    return rc;
+}

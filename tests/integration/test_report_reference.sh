@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# `tcbench report RUN --reference`: a run beside published numbers, in the
+# paper's shape, with ours/paper and the order of the methods, written as
+# Markdown, LaTeX and CSV; the tables come from the run's config; bad
+# references are errors that name the file and key and write nothing.
+set -euo pipefail
+: "${TCBENCH:?}"
+. "$(dirname "${BASH_SOURCE[0]}")/expect.sh"
+
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+cd "$tmp"
+
+cat > c.json <<'JSON'
+{ "name": "c", "output": "run", "evaluation": { "pairs": 30 },
+  "reference": { "source": "toy", "tables": ["B"] },
+  "datasets": [ { "name": "synth", "source": "synthetic", "frames": 8,
+                  "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
+  "methods": [ { "name": "oracle" }, { "name": "nearest" } ] }
+JSON
+"$TCBENCH" run c.json --quiet 2> /dev/null
+sl2=$(/usr/bin/python3 -c "import json; print(json.load(open('run/cells/synth/quadruped_walk/nearest/seed_0.json'))['summary']['sl2']['mean'] * 1e3)")
+
+# The paper of this test says nearest is twice as good as this run finds it, and
+# better than the oracle: a flip. Table A is not the config's and stays out.
+/usr/bin/python3 - "$sl2" <<'PY'
+import json, sys
+sl2 = float(sys.argv[1])
+row = lambda m, v: {"paper_row": "row " + m, "dataset": "synth", "sequence": "quadruped_walk", "method": m,
+                    "sl2": v, "rank": None, "auc": [50.0, 1.0], "cd": None}
+json.dump({"format": "tcbench-reference/1", "name": "toy", "paper": "A toy paper",
+           "tables": [{"id": "A", "title": "Table A", "rows": [row("oracle", [1, 1])]},
+                      {"id": "B", "title": "Table B: toy", "rows": [row("oracle", [sl2, 2.0]), row("nearest", [sl2 / 2, None]),
+                                                                    row("absent", [1.0, 1.0])]}]},
+          open("toy.json", "w"))
+PY
+expect 0 "## Table B: toy" "$TCBENCH" report run --reference toy.json
+grep -qF "Table A" out.txt && { echo "FAIL: table A is not the config's"; cat out.txt; exit 1; }
+grep -qE "^\| row nearest \| nearest \| [0-9.]+ ± [0-9.]+ \| [0-9.]+ \| 2\.00 \|" out.txt || { echo "FAIL: nearest row"; cat out.txt; exit 1; }
+grep -qE "^\| row oracle \| oracle \| 0\.00 ± 0\.00 \| [0-9.]+ ± 2\.00 \| 0\.00 \|" out.txt || { echo "FAIL: oracle row"; cat out.txt; exit 1; }
+grep -qF "| row absent | absent | not run |" out.txt || { echo "FAIL: absent row"; cat out.txt; exit 1; }
+grep -qF -- "- m_sL2 ↓: flips 1 of 1 pairs, e.g. the paper has row nearest better than row oracle, this run the reverse" out.txt ||
+    { echo "FAIL: no flip"; cat out.txt; exit 1; }
+grep -qF -- "- AUC ↑: nothing to order" out.txt || { echo "FAIL: AUC ties order nothing"; cat out.txt; exit 1; }
+for f in md tex csv; do [ -s "run/report/reference_toy.$f" ]; done
+grep -qF '\begin{tabular}' run/report/reference_toy.tex && grep -qF '\toprule' run/report/reference_toy.tex
+/usr/bin/python3 - <<'PY'
+import csv
+rows = list(csv.DictReader(open("run/report/reference_toy.csv")))
+near = [r for r in rows if r["method"] == "nearest" and r["metric"] == "sl2"][0]
+assert abs(float(near["ratio"]) - 2) < 1e-5 and near["paper_std"] == "" and near["status"] == "ok", near
+assert [r["status"] for r in rows if r["method"] == "absent"] == ["not run", "not run"]
+PY
+
+# Without a "reference" in the config: every table naming a cell of the run.
+sed -i 's/"reference": { "source": "toy", "tables": \["B"\] },//' run/config.json
+expect 0 "" "$TCBENCH" report run --reference toy.json --out elsewhere --quiet
+[ ! -s out.txt ] && grep -qF "## Table A" elsewhere/reference_toy.md && grep -qF "## Table B" elsewhere/reference_toy.md
+
+# Errors name what is wrong and write nothing.
+rm -rf run/report
+expect 2 "--reference iccv22: no such built-in reference" "$TCBENCH" report run --reference iccv22
+expect 2 "no table of reference iccv21 names a cell of this run" "$TCBENCH" report run --reference iccv21
+sed 's/"sl2": \[1, 1\]/"sl2": "high"/' toy.json > bad.json
+expect 2 "bad.json: tables[0].rows[0].sl2: expected null or [mean, std]" "$TCBENCH" report run --reference bad.json
+expect 2 "missing.json" "$TCBENCH" report run --reference missing.json
+[ ! -e run/report ] || { echo "FAIL: a failed report wrote run/report"; ls run/report; exit 1; }
+echo "reference report test passed"
