@@ -38,6 +38,18 @@ int tcb_run_root_missing(const tcb_dataset_spec *d);
 /* why: "no root given (--root NAME=DIR or TCBENCH_ROOT_NAME)" or "<root> not found". */
 void tcb_run_missing_root_text(const tcb_dataset_spec *d, char *out, size_t size);
 
+/* The grid in cell-id order (harness/grid.c). */
+typedef struct tcb_grid_cell {
+    int id;
+    const tcb_dataset_spec *dataset;
+    const tcb_sequence_spec *sequence;
+    const tcb_method_spec *method;
+    int seed;
+} tcb_grid_cell;
+typedef int (*tcb_grid_visit)(void *ctx, const tcb_grid_cell *c);
+int tcb_grid_for_each(const tcb_config *cfg, tcb_grid_visit visit, void *ctx); /* stops at a visit's error */
+int tcb_grid_cells_per_sequence(const tcb_config *cfg, const tcb_dataset_spec *d);
+
 /* Short git revision of the source tree tcbench was built from, or
  * "unknown". (harness/sysinfo.c) */
 void tcb_git_revision(char *out, size_t size);

@@ -17,8 +17,8 @@
 
 enum {
     F_OUT, F_ONLY, F_FORCE, F_QUIET, F_REPORT, F_SEED, F_FRAMES, F_SEQUENCE, F_UPDATE,
-    F_PLUGIN, F_THREADS, F_VERBOSE, F_SAMPLES, F_PLOT, F_ROOT, F_VARIANT, F_DRY_RUN, F_REFERENCE, F_HELP,
-    F_COUNT
+    F_PLUGIN, F_THREADS, F_VERBOSE, F_SAMPLES, F_PLOT, F_ROOT, F_VARIANT, F_DRY_RUN, F_REFERENCE, F_CELL,
+    F_SHARD, F_HELP, F_COUNT
 };
 #define BIT(f) (1u << (f))
 
@@ -32,6 +32,7 @@ static const struct {
     [F_PLUGIN] = {"--plugin", 1}, [F_THREADS] = {"--threads", 1}, [F_VERBOSE] = {"--verbose", 0},
     [F_SAMPLES] = {"--samples", 1}, [F_PLOT] = {"--plot", 1}, [F_ROOT] = {"--root", 1},
     [F_VARIANT] = {"--variant", 1}, [F_DRY_RUN] = {"--dry-run", 0}, [F_REFERENCE] = {"--reference", 1},
+    [F_CELL] = {"--cell", 1},    [F_SHARD] = {"--shard", 1},
     [F_HELP] = {"--help", 0},
 };
 
@@ -98,35 +99,44 @@ static int int_option(const cli *c, int f, long long def, long long *out)
 
 /* ---- commands ------------------------------------------------------- */
 
-static int cmd_run(const cli *c)
+/* The config as the command line shapes it: variant, roots, threads (the
+ * flag, else Slurm's SLURM_CPUS_PER_TASK, else the config's). */
+static int load_config(const cli *c, tcb_config *cfg)
 {
     tcb_error err = {0};
-    tcb_config cfg;
     long long threads;
     if (int_option(c, F_THREADS, 0, &threads)) return 2;
+    const char *slurm = getenv("SLURM_CPUS_PER_TASK");
+    if (!threads && slurm && atoi(slurm) > 0) threads = atoi(slurm);
     tcb_config_opts co = {c->value[F_VARIANT], c->n_roots, c->roots};
-    if (tcb_config_load_opts(c->arg[0], &co, &cfg, &err)) return fail(&err);
-    if (threads > 0) cfg.threads = (int)(threads > 1024 ? 1024 : threads);
-    if (c->set[F_DRY_RUN]) {
-        tcb_run_opts dry = {c->value[F_OUT], c->value[F_ONLY], c->set[F_FORCE], {0}};
-        int rc = tcb_run_dry(&cfg, &dry, stdout, &err);
-        tcb_config_free(&cfg);
-        return rc ? fail(&err) : 0;
-    }
-    tcb_term_progress tp;
-    tcb_term_progress_init(&tp, stderr, c->set[F_QUIET] ? 1 : -1);
-    tp.verbose = c->set[F_VERBOSE];
-    tcb_run_opts opts = {c->value[F_OUT], c->value[F_ONLY], c->set[F_FORCE],
-                         tcb_term_progress_reporter(&tp)};
-    tcb_run_stats st;
-    int rc = tcb_run(&cfg, &opts, &st, &err);
-    tcb_term_progress_finish(&tp);
-    char run_dir[TCB_PATH_MAX];
-    snprintf(run_dir, sizeof run_dir, "%s", opts.output ? opts.output : cfg.output);
-    tcb_config_free(&cfg);
-    if (rc) return fail(&err);
-    fprintf(stderr, "cells: %d in all, %d computed, %d already done, %d failed\n", st.cells_total,
-            st.cells_done, st.cells_skipped, st.cells_failed);
+    if (tcb_config_load_opts(c->arg[0], &co, cfg, &err)) return fail(&err);
+    if (threads > 0) cfg->threads = (int)(threads > 1024 ? 1024 : threads);
+    return 0;
+}
+
+/* --cell and --shard as a mask over the config's cell ids; *mask NULL:
+ * every cell. */
+static int cell_mask(const cli *c, const tcb_config *cfg, unsigned char **mask)
+{
+    tcb_error err = {0};
+    int n = tcb_grid_count(cfg);
+    *mask = NULL;
+    if (!c->set[F_CELL] && !c->set[F_SHARD]) return 0;
+    if (!(*mask = malloc(n ? (size_t)n : 1))) return fprintf(stderr, "tcbench: out of memory\n"), 1;
+    memset(*mask, 1, (size_t)n);
+    int rc = c->set[F_CELL] ? tcb_cell_set_parse(c->value[F_CELL], n, *mask, &err) : TCB_OK;
+    if (!rc && c->set[F_SHARD]) rc = tcb_shard_parse(c->value[F_SHARD], n, *mask, &err);
+    if (!rc) return 0;
+    free(*mask);
+    *mask = NULL;
+    return fail(&err);
+}
+
+static int finish_run(const cli *c, const char *run_dir, const tcb_run_stats *st)
+{
+    tcb_error err = {0};
+    fprintf(stderr, "cells: %d in all, %d computed, %d already done, %d failed\n", st->cells_total,
+            st->cells_done, st->cells_skipped, st->cells_failed);
     fprintf(stderr, "results: %s\n", run_dir);
     if (!c->set[F_REPORT]) {
         fprintf(stderr, "make the report: tcbench report %s\n", run_dir);
@@ -135,6 +145,45 @@ static int cmd_run(const cli *c)
     if (tcb_report_write(run_dir, NULL, c->set[F_QUIET] ? NULL : stdout, &err)) return fail(&err);
     fprintf(stderr, "report: %s/report/\n", run_dir);
     return 0;
+}
+
+static int cmd_run(const cli *c)
+{
+    tcb_error err = {0};
+    tcb_config cfg;
+    unsigned char *mask;
+    int rc = load_config(c, &cfg);
+    if (rc) return rc;
+    if ((rc = cell_mask(c, &cfg, &mask))) {
+        tcb_config_free(&cfg);
+        return rc;
+    }
+    tcb_term_progress tp;
+    tcb_term_progress_init(&tp, stderr, c->set[F_QUIET] ? 1 : -1);
+    tp.verbose = c->set[F_VERBOSE];
+    tcb_run_opts opts = {c->value[F_OUT], c->value[F_ONLY], c->set[F_FORCE],
+                         c->set[F_DRY_RUN] ? (tcb_reporter){0} : tcb_term_progress_reporter(&tp), mask};
+    tcb_run_stats st;
+    rc = c->set[F_DRY_RUN] ? tcb_run_dry(&cfg, &opts, stdout, &err) : tcb_run(&cfg, &opts, &st, &err);
+    tcb_term_progress_finish(&tp);
+    char run_dir[TCB_PATH_MAX];
+    snprintf(run_dir, sizeof run_dir, "%s", opts.output ? opts.output : cfg.output);
+    tcb_config_free(&cfg);
+    free(mask);
+    if (rc) return fail(&err);
+    return c->set[F_DRY_RUN] ? 0 : finish_run(c, run_dir, &st);
+}
+
+static int cmd_cells(const cli *c)
+{
+    tcb_error err = {0};
+    tcb_config cfg;
+    int rc = load_config(c, &cfg);
+    if (rc) return rc;
+    tcb_run_opts opts = {c->value[F_OUT], NULL, 0, {0}, NULL};
+    rc = tcb_run_list_cells(&cfg, &opts, stdout, &err);
+    tcb_config_free(&cfg);
+    return rc ? fail(&err) : 0;
 }
 
 static int cmd_report(const cli *c)
@@ -295,11 +344,11 @@ static int cmd_help(const cli *c);
 static const command commands[] = {
     {"run", cmd_run,
      BIT(F_OUT) | BIT(F_ONLY) | BIT(F_FORCE) | BIT(F_QUIET) | BIT(F_REPORT) | BIT(F_THREADS) | BIT(F_VERBOSE) |
-         BIT(F_ROOT) | BIT(F_VARIANT) | BIT(F_DRY_RUN),
+         BIT(F_ROOT) | BIT(F_VARIANT) | BIT(F_DRY_RUN) | BIT(F_CELL) | BIT(F_SHARD),
      1, 1, "CONFIG",
      "usage: tcbench run CONFIG [--root DATASET=DIR]... [--variant NAME] [--dry-run] [--out DIR]\n"
-     "                  [--only METHOD] [--threads N] [--force] [--quiet] [--verbose] [--report]\n"
-     "                  [--plugin SO]...\n"
+     "                  [--only METHOD] [--cell IDS] [--shard I/N|auto] [--threads N] [--force]\n"
+     "                  [--quiet] [--verbose] [--report] [--plugin SO]...\n"
      "\n"
      "Runs every (dataset, sequence, method, seed) cell of the config and writes one\n"
      "result file per cell. Finished cells are skipped, so rerunning a killed run\n"
@@ -313,8 +362,12 @@ static const command commands[] = {
      "  --dry-run      list the cells, their state and an estimate of their compute; run nothing\n"
      "  --out DIR      run directory (default: the config's \"output\")\n"
      "  --only METHOD  run only the method with this label\n"
-     "  --threads N    threads per cell (default: the config's \"threads\", else 2); two\n"
-     "                 processes with --only and --threads 1 use two cores more evenly\n"
+     "  --cell IDS     run only these cells (\"3,5-7\"; ids as 'tcbench cells' lists them)\n"
+     "  --shard I/N    run only the cells whose id is I modulo N; 'auto' takes I and N from\n"
+     "                 a Slurm array task (SLURM_ARRAY_TASK_ID, _MIN/_MAX or _COUNT)\n"
+     "  --threads N    threads per cell (default: SLURM_CPUS_PER_TASK under Slurm, else the\n"
+     "                 config's \"threads\", else 2); two processes with --only and\n"
+     "                 --threads 1 use two cores more evenly\n"
      "  --force        recompute cells that are already finished\n"
      "  --quiet        no progress output (also when the CI variable is set)\n"
      "  --verbose      also the methods' debug lines (a training's mean loss every 1 000 iterations)\n"
@@ -333,6 +386,21 @@ static const command commands[] = {
      "examples:\n"
      "  tcbench run configs/quick.json --out runs/quick --report\n"
      "  tcbench run configs/paper/table5-nricp.json --root ama=../shared/data/ama --dry-run\n"},
+    {"cells", cmd_cells, BIT(F_OUT) | BIT(F_ROOT) | BIT(F_VARIANT), 1, 1, "CONFIG",
+     "usage: tcbench cells CONFIG [--variant NAME] [--root DATASET=DIR]... [--out DIR]\n"
+     "\n"
+     "Lists the config's cells, numbered in one fixed order (datasets, sequences,\n"
+     "methods, seeds) that depends only on the config, with each cell's state in the\n"
+     "run directory: done, failed, diverged or missing. 'tcbench run --cell' and\n"
+     "'--shard' take these ids.\n"
+     "\n"
+     "options:\n"
+     "  --variant NAME  the config's variant (default: its first)\n"
+     "  --root D=DIR    as for run (the states do not depend on it)\n"
+     "  --out DIR       run directory (default: the config's \"output\")\n"
+     "\n"
+     "example:\n"
+     "  tcbench cells configs/paper/table5-nricp.json\n"},
     {"report", cmd_report, BIT(F_OUT) | BIT(F_QUIET) | BIT(F_REFERENCE), 1, 1, "RUN_DIR",
      "usage: tcbench report RUN_DIR [--reference NAME] [--out DIR] [--quiet]\n"
      "\n"
@@ -456,6 +524,7 @@ static const char general_help[] =
     "\n"
     "commands:\n"
     "  run       run the grid of a config (resumable)\n"
+    "  cells     the numbered cells of a config and their state\n"
     "  report    tables and plots from a run directory\n"
     "  methods   list the registered methods\n"
     "  datasets  list or export the synthetic sequences, align an OBJ sequence's rotations\n"

@@ -57,7 +57,7 @@ static const char *cell_state(const char *run_dir, const tcb_dataset_spec *d, co
         return "missing";
     tcb_cell_result c;
     if (tcb_cell_load(path, &c, &err)) return "unreadable";
-    const char *state = tcb_cell_status_name(c.status);
+    const char *state = c.status == TCB_CELL_OK ? "done" : tcb_cell_status_name(c.status);
     tcb_cell_free(&c);
     return state;
 }
@@ -78,44 +78,53 @@ static void estimate_cell(const tcb_method_spec *m, const tcb_cost_query *q, tcb
         e->eval_s = -1;
 }
 
-static void plan_method(FILE *out, const tcb_run_opts *opts, const char *run_dir, const tcb_dataset_spec *d, const char *seq,
-                        const tcb_method_spec *m, const tcb_cost_query *q, int *id, int selected, plan_totals *t)
+typedef struct plan_walk {
+    FILE *out;
+    const tcb_config *cfg;
+    const tcb_run_opts *opts;
+    const char *run_dir;
+    const tcb_sequence_spec *current; /* the sequence whose header was printed */
+    tcb_cost_query q;
+    plan_totals t;
+} plan_walk;
+
+static void sequence_header(plan_walk *w, const tcb_dataset_spec *d, const char *seq)
 {
-    tcb_cost_estimate e;
-    estimate_cell(m, q, &e);
-    for (int s = 0; s < m->n_seeds; s++, (*id)++) {
-        if (!selected) continue;
-        const char *state = cell_state(run_dir, d, seq, m, m->seeds[s]);
-        int runs = opts->force || strcmp(state, "missing") == 0 || strcmp(state, "unreadable") == 0;
-        char fit[32], eval[32];
-        duration_text(e.fit_s, fit, sizeof fit);
-        duration_text(e.eval_s, eval, sizeof eval);
-        fprintf(out, "  %4d  %-24s %4d  %-10s %9s %9s  %s\n", *id, m->label, m->seeds[s], state, fit, eval,
-                e.basis);
-        t->cells++;
-        if (!runs) {
-            t->done++;
-            continue;
-        }
-        t->to_run++;
-        if (e.fit_s < 0 || e.eval_s < 0) t->unknown++;
-        else t->seconds += e.fit_s + e.eval_s;
+    if (tcb_run_root_missing(d) && seq == d->sequences[0].name) {
+        char why[TCB_PATH_MAX + 64];
+        tcb_run_missing_root_text(d, why, sizeof why);
+        fprintf(w->out, "dataset %s: %s%s\n", d->name, why, d->optional ? " (optional: skipped by a run)" : "");
     }
+    w->q = (tcb_cost_query){0, 0, w->cfg->eval_pairs, w->cfg->threads};
+    probe(d, seq, &w->q.n_frames, &w->q.n_verts);
+    if (w->q.n_frames)
+        fprintf(w->out, "%s/%s: %d frames, %d vertices, %d pairs\n", d->name, seq, w->q.n_frames, w->q.n_verts,
+                w->q.n_pairs);
+    else
+        fprintf(w->out, "%s/%s: data absent, %d pairs\n", d->name, seq, w->q.n_pairs);
+    fprintf(w->out, "  %4s  %-24s %4s  %-10s %9s %9s  %s\n", "id", "method", "seed", "state", "fit", "eval", "basis");
 }
 
-static void plan_sequence(FILE *out, const tcb_config *cfg, const tcb_run_opts *opts, const char *run_dir,
-                          const tcb_dataset_spec *d, const char *seq, int *id, plan_totals *t)
+static int plan_cell(void *ctx, const tcb_grid_cell *c)
 {
-    tcb_cost_query q = {0, 0, cfg->eval_pairs, cfg->threads};
-    probe(d, seq, &q.n_frames, &q.n_verts);
-    if (q.n_frames) fprintf(out, "%s/%s: %d frames, %d vertices, %d pairs\n", d->name, seq, q.n_frames, q.n_verts,
-                            q.n_pairs);
-    else fprintf(out, "%s/%s: data absent, %d pairs\n", d->name, seq, q.n_pairs);
-    fprintf(out, "  %4s  %-24s %4s  %-10s %9s %9s  %s\n", "id", "method", "seed", "state", "fit", "eval", "basis");
-    for (int k = 0; k < cfg->n_methods; k++) {
-        const tcb_method_spec *m = &cfg->methods[k];
-        if (tcb_method_runs_on(m, d->name)) plan_method(out, opts, run_dir, d, seq, m, &q, id, tcb_run_selected(opts, m), t);
-    }
+    plan_walk *w = ctx;
+    if (!tcb_run_selected(w->opts, c->method) || (w->opts->cells && !w->opts->cells[c->id])) return TCB_OK;
+    if (w->current != c->sequence) sequence_header(w, c->dataset, c->sequence->name);
+    w->current = c->sequence;
+    tcb_cost_estimate e;
+    estimate_cell(c->method, &w->q, &e);
+    const char *state = cell_state(w->run_dir, c->dataset, c->sequence->name, c->method, c->seed);
+    int runs = w->opts->force || !strcmp(state, "missing") || !strcmp(state, "unreadable");
+    char fit[32], eval[32];
+    duration_text(e.fit_s, fit, sizeof fit);
+    duration_text(e.eval_s, eval, sizeof eval);
+    fprintf(w->out, "  %4d  %-24s %4d  %-10s %9s %9s  %s\n", c->id, c->method->label, c->seed, state, fit, eval,
+            e.basis);
+    w->t.cells++;
+    if (!runs) w->t.done++;
+    else if (w->t.to_run++, e.fit_s < 0 || e.eval_s < 0) w->t.unknown++;
+    else w->t.seconds += e.fit_s + e.eval_s;
+    return TCB_OK;
 }
 
 int tcb_run_dry(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_error *err)
@@ -125,18 +134,9 @@ int tcb_run_dry(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_
     if (!rc) rc = tcb_run_check_methods(cfg, opts, err);
     if (rc) return rc;
     fprintf(out, "%s: %s, %d thread%s per cell\n", cfg->path, run_dir, cfg->threads, cfg->threads == 1 ? "" : "s");
-    plan_totals t = {0};
-    int id = 0;
-    for (int k = 0; k < cfg->n_datasets; k++) {
-        const tcb_dataset_spec *d = &cfg->datasets[k];
-        if (tcb_run_root_missing(d)) {
-            char why[TCB_PATH_MAX + 64];
-            tcb_run_missing_root_text(d, why, sizeof why);
-            fprintf(out, "dataset %s: %s%s\n", d->name, why, d->optional ? " (optional: skipped by a run)" : "");
-        }
-        for (int s = 0; s < d->n_sequences; s++)
-            plan_sequence(out, cfg, opts, run_dir, d, d->sequences[s].name, &id, &t);
-    }
+    plan_walk w = {out, cfg, opts, run_dir, NULL, {0}, {0}};
+    tcb_grid_for_each(cfg, plan_cell, &w);
+    plan_totals t = w.t;
     char total[32];
     duration_text(t.seconds, total, sizeof total);
     fprintf(out, "cells: %d, %d finished, %d to run: about %s of wall time one after another", t.cells, t.done,
@@ -144,4 +144,25 @@ int tcb_run_dry(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_
     if (t.unknown) fprintf(out, ", plus %d cell%s without an estimate", t.unknown, t.unknown == 1 ? "" : "s");
     fprintf(out, "\n");
     return TCB_OK;
+}
+
+typedef struct list_walk {
+    FILE *out;
+    const char *run_dir;
+} list_walk;
+
+static int list_cell(void *ctx, const tcb_grid_cell *c)
+{
+    const list_walk *w = ctx;
+    fprintf(w->out, "%5d  %-12s %-20s %-24s %4d  %s\n", c->id, c->dataset->name, c->sequence->name,
+            c->method->label, c->seed, cell_state(w->run_dir, c->dataset, c->sequence->name, c->method, c->seed));
+    return TCB_OK;
+}
+
+int tcb_run_list_cells(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_error *err)
+{
+    (void)err;
+    list_walk w = {out, opts->output ? opts->output : cfg->output};
+    fprintf(out, "%5s  %-12s %-20s %-24s %4s  %s\n", "id", "dataset", "sequence", "method", "seed", "state");
+    return tcb_grid_for_each(cfg, list_cell, &w);
 }

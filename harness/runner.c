@@ -261,13 +261,36 @@ static int run_cell(const run_state *st, const seq_ctx *sc, const tcb_method_spe
     return rc;
 }
 
-static int run_cells(const run_state *st, const seq_ctx *sc, tcb_error *err)
+/* The cell with this id and method is one the options ask for. */
+static int cell_wanted(const tcb_run_opts *opts, int id, const tcb_method_spec *m)
+{
+    return tcb_run_selected(opts, m) && (!opts->cells || opts->cells[id]);
+}
+
+/* Whether any cell of the sequence whose cells start at `first` is wanted:
+ * one that is not is never loaded. */
+static int sequence_wanted(const run_state *st, const tcb_dataset_spec *d, int first)
+{
+    int id = first;
+    for (int k = 0; k < st->cfg->n_methods; k++) {
+        const tcb_method_spec *m = &st->cfg->methods[k];
+        if (!tcb_method_runs_on(m, d->name)) continue;
+        for (int s = 0; s < m->n_seeds; s++, id++)
+            if (cell_wanted(st->opts, id, m)) return 1;
+    }
+    return 0;
+}
+
+/* The sequence's cells, ids from `first` on (grid order, harness/grid.c). */
+static int run_cells(const run_state *st, const seq_ctx *sc, int first, tcb_error *err)
 {
     const tcb_config *cfg = st->cfg;
+    int id = first;
     for (int k = 0; k < cfg->n_methods; k++) {
         const tcb_method_spec *m = &cfg->methods[k];
-        if (!tcb_run_selected(st->opts, m) || !tcb_method_runs_on(m, sc->dataset->name)) continue;
-        for (int s = 0; s < m->n_seeds; s++) {
+        if (!tcb_method_runs_on(m, sc->dataset->name)) continue;
+        for (int s = 0; s < m->n_seeds; s++, id++) {
+            if (!cell_wanted(st->opts, id, m)) continue;
             char path[TCB_PATH_MAX];
             int rc = tcb_cell_path(path, sizeof path, st->run_dir, sc->dataset->name,
                                    sc->seq->name, m->label, m->seeds[s], err);
@@ -284,9 +307,10 @@ static int run_cells(const run_state *st, const seq_ctx *sc, tcb_error *err)
     return TCB_OK;
 }
 
-static int run_sequence(const run_state *st, const tcb_dataset_spec *d, const tcb_sequence_spec *s,
+static int run_sequence(const run_state *st, const tcb_dataset_spec *d, const tcb_sequence_spec *s, int first,
                         tcb_error *err)
 {
+    if (!sequence_wanted(st, d, first)) return TCB_OK;
     tcb_sequence seq = {0};
     tcb_split split = {0};
     char split_path[TCB_PATH_MAX];
@@ -297,7 +321,7 @@ static int run_sequence(const run_state *st, const tcb_dataset_spec *d, const tc
     seq_ctx sc = {d, &seq, &split, split_path, tcb_now_seconds() - t0};
     rc = tcb_harness_obtain_split(st->cfg, d, s, seq.n_frames, split_path, sizeof split_path,
                                   &split, err);
-    if (!rc) rc = run_cells(st, &sc, err);
+    if (!rc) rc = run_cells(st, &sc, first, err);
     tcb_split_free(&split);
     tcb_sequence_free(&seq);
     return rc;
@@ -343,17 +367,18 @@ int tcb_run(const tcb_config *cfg, const tcb_run_opts *opts, tcb_run_stats *stat
     if (!rc) rc = write_config(&st, err);
     if (rc) return rc;
     tcb_git_revision(st.git_revision, sizeof st.git_revision);
-    for (int k = 0; k < cfg->n_datasets && !rc; k++) {
+    for (int k = 0, first = 0; k < cfg->n_datasets && !rc; k++) {
         const tcb_dataset_spec *d = &cfg->datasets[k];
+        int per_sequence = tcb_grid_cells_per_sequence(cfg, d);
         if (tcb_run_root_missing(d)) {
             /* A warning, not info: a silently shorter table would mislead. */
             char why[TCB_PATH_MAX + 64];
             tcb_run_missing_root_text(d, why, sizeof why);
             tcb_report_log(&opts->reporter, TCB_LOG_WARN, "dataset %s skipped: %s (optional)", d->name, why);
-            continue;
         }
-        for (int s = 0; s < d->n_sequences && !rc; s++)
-            rc = run_sequence(&st, d, &d->sequences[s], err);
+        for (int s = 0; s < d->n_sequences && !rc && !tcb_run_root_missing(d); s++)
+            rc = run_sequence(&st, d, &d->sequences[s], first + s * per_sequence, err);
+        first += d->n_sequences * per_sequence;
     }
     return rc;
 }

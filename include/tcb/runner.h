@@ -22,7 +22,19 @@ typedef struct tcb_run_opts {
     const char *only_method; /* run only this method label (NULL: all) */
     int force;               /* recompute finished cells */
     tcb_reporter reporter;
+    const unsigned char *cells; /* [tcb_grid_count] 1: run cell id k; NULL: every cell */
 } tcb_run_opts;
+
+/* The number of cells of the config, numbered 0.. in grid order (datasets,
+ * sequences, methods, seeds): an id depends only on the config. */
+int tcb_grid_count(const tcb_config *cfg);
+/* mask[k] = 1 for the ids of spec ("3,5-7"), 0 for the others; errors name
+ * the spec. */
+int tcb_cell_set_parse(const char *spec, int n_cells, unsigned char *mask, tcb_error *err);
+/* Keeps in mask only ids ≡ I mod N for spec "I/N", or for "auto" Slurm's
+ * array task (SLURM_ARRAY_TASK_ID against SLURM_ARRAY_TASK_MIN/MAX or
+ * SLURM_ARRAY_TASK_COUNT). */
+int tcb_shard_parse(const char *spec, int n_cells, unsigned char *mask, tcb_error *err);
 
 typedef struct tcb_run_stats {
     int cells_total, cells_done, cells_skipped, cells_failed;
@@ -36,6 +48,10 @@ int tcb_run(const tcb_config *cfg, const tcb_run_opts *opts, tcb_run_stats *stat
  * take, from each method's step costs; loads plug-ins and checks the
  * methods as tcb_run does, and runs nothing. */
 int tcb_run_dry(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_error *err);
+
+/* `tcbench cells`: every cell of the config, in id order, with its state in
+ * the run directory (done, failed, diverged, missing). */
+int tcb_run_list_cells(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_error *err);
 
 #ifdef __cplusplus
 }

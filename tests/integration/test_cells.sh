@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# Cells by number: `tcbench cells` lists a config's cells in an order that
+# depends only on the config; `run --cell` and `run --shard I/N` (or
+# `--shard auto` under a Slurm array) run exactly those, and shards put
+# together equal a plain run bit for bit.
+set -euo pipefail
+: "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
+. "$(dirname "${BASH_SOURCE[0]}")/expect.sh"
+source "$TCB_SOURCE_DIR/tests/integration/cells.sh"
+
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+cd "$tmp"
+
+cat > g.json <<'JSON'
+{ "name": "g", "output": "plain", "seeds": [0, 1], "evaluation": { "pairs": 15 },
+  "datasets": [
+    { "name": "a", "source": "synthetic", "frames": 6, "sequences": [ { "name": "quadruped_walk", "role": "test" } ] },
+    { "name": "b", "source": "synthetic", "frames": 6,
+      "sequences": [ { "name": "quadruped_walk", "role": "test" }, { "name": "humanoid_jacks", "role": "test" } ] } ],
+  "methods": [ { "name": "oracle" }, { "name": "nearest", "seeds": [3], "datasets": ["b"] } ] }
+JSON
+expect 0 "" "$TCBENCH" cells g.json
+/usr/bin/python3 - <<'PY'
+rows = [l.split() for l in open("out.txt").read().splitlines()[1:]]
+want = [("a", "quadruped_walk", "oracle", "0"), ("a", "quadruped_walk", "oracle", "1"),
+        ("b", "quadruped_walk", "oracle", "0"), ("b", "quadruped_walk", "oracle", "1"), ("b", "quadruped_walk", "nearest", "3"),
+        ("b", "humanoid_jacks", "oracle", "0"), ("b", "humanoid_jacks", "oracle", "1"), ("b", "humanoid_jacks", "nearest", "3")]
+assert [tuple(r[1:5]) for r in rows] == want, rows
+assert [r[0] for r in rows] == [str(k) for k in range(8)] and {r[5] for r in rows} == {"missing"}, rows
+PY
+"$TCBENCH" run g.json --quiet 2> /dev/null
+
+expect 0 "cells: 3 in all, 3 computed" "$TCBENCH" run g.json --out picked --cell 1,4-5 --quiet
+ls picked/cells/a/quadruped_walk/oracle/seed_1.json picked/cells/b/quadruped_walk/nearest/seed_3.json \
+   picked/cells/b/humanoid_jacks/oracle/seed_0.json > /dev/null
+[ "$(find picked/cells -name '*.json' | wc -l)" -eq 3 ]
+expect 0 "" "$TCBENCH" cells g.json --out picked
+[ "$(grep -c ' done$' out.txt)" -eq 3 ] && grep -qE "^ +4 .* nearest +3  done$" out.txt || { cat out.txt; exit 1; }
+
+# Three shards, one of them as a Slurm array task (ids 5..7 of an array 5-7).
+expect 0 "cells: 3 in all" "$TCBENCH" run g.json --out sharded --shard 0/3 --quiet
+SLURM_ARRAY_TASK_ID=6 SLURM_ARRAY_TASK_MIN=5 SLURM_ARRAY_TASK_MAX=7 \
+    expect 0 "cells: 3 in all" "$TCBENCH" run g.json --out sharded --shard auto --quiet
+SLURM_ARRAY_TASK_ID=2 SLURM_ARRAY_TASK_COUNT=3 \
+    expect 0 "cells: 2 in all" "$TCBENCH" run g.json --out sharded --shard auto --quiet
+same_cells plain sharded
+
+expect 2 "--cell 8: cell 8 does not exist (the config has 8 cells, 0-7)" "$TCBENCH" run g.json --cell 8
+expect 2 "--cell 3-x: expected ids and ranges such as 3,5-7" "$TCBENCH" run g.json --cell 3-x
+expect 2 "--cell 5-2: range 5-2 runs backwards" "$TCBENCH" run g.json --cell 5-2
+expect 2 "--shard 3/3: expected I/N with 0 <= I < N, or auto" "$TCBENCH" run g.json --shard 3/3
+expect 2 "--shard auto: SLURM_ARRAY_TASK_ID is not set" env -u SLURM_ARRAY_TASK_ID "$TCBENCH" run g.json --shard auto
+echo "cells test passed"
