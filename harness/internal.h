@@ -6,6 +6,7 @@
 #include <stddef.h>
 
 #include <cjson/cJSON.h>
+#include <pthread.h>
 
 #include "tcb/config.h"
 #include "tcb/method.h"
@@ -49,6 +50,35 @@ typedef struct tcb_grid_cell {
 typedef int (*tcb_grid_visit)(void *ctx, const tcb_grid_cell *c);
 int tcb_grid_for_each(const tcb_config *cfg, tcb_grid_visit visit, void *ctx); /* stops at a visit's error */
 int tcb_grid_cells_per_sequence(const tcb_config *cfg, const tcb_dataset_spec *d);
+
+/* Cell locks (harness/cell_lock.c): <cell>.json.lock, created atomically
+ * with link(2), heartbeat = its mtime. */
+typedef struct tcb_lock_info {
+    int valid;                  /* the content parsed */
+    char host[256];
+    long pid;
+    double started;             /* Unix time */
+    double heartbeat_age_s;     /* now − mtime */
+} tcb_lock_info;
+
+typedef struct tcb_cell_lock {
+    char path[TCB_PATH_MAX];
+    int held, beating, stop;
+    double timeout_s;
+    pthread_t thread;           /* refreshes the heartbeat every timeout/4 */
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+} tcb_cell_lock;
+
+/* Claims the cell at cell_path: l->held = 1 on success. When another live
+ * process holds it, returns TCB_OK with l->held = 0 and the holder in
+ * *holder; a stale lock is taken over and `note` says whose and why. */
+int tcb_cell_lock_acquire(tcb_cell_lock *l, const char *cell_path, double timeout_s, tcb_lock_info *holder,
+                          char *note, size_t note_size, tcb_error *err);
+/* Stops the heartbeat and removes the lock; nothing when not held. */
+void tcb_cell_lock_release(tcb_cell_lock *l);
+/* The lock file at `path` (<cell>.json.lock): 0, or -1 when there is none. */
+int tcb_cell_lock_read(const char *path, tcb_lock_info *info);
 
 /* Short git revision of the source tree tcbench was built from, or
  * "unknown". (harness/sysinfo.c) */

@@ -18,7 +18,7 @@
 enum {
     F_OUT, F_ONLY, F_FORCE, F_QUIET, F_REPORT, F_SEED, F_FRAMES, F_SEQUENCE, F_UPDATE,
     F_PLUGIN, F_THREADS, F_VERBOSE, F_SAMPLES, F_PLOT, F_ROOT, F_VARIANT, F_DRY_RUN, F_REFERENCE, F_CELL,
-    F_SHARD, F_HELP, F_COUNT
+    F_SHARD, F_LOCK_TIMEOUT, F_HELP, F_COUNT
 };
 #define BIT(f) (1u << (f))
 
@@ -32,7 +32,7 @@ static const struct {
     [F_PLUGIN] = {"--plugin", 1}, [F_THREADS] = {"--threads", 1}, [F_VERBOSE] = {"--verbose", 0},
     [F_SAMPLES] = {"--samples", 1}, [F_PLOT] = {"--plot", 1}, [F_ROOT] = {"--root", 1},
     [F_VARIANT] = {"--variant", 1}, [F_DRY_RUN] = {"--dry-run", 0}, [F_REFERENCE] = {"--reference", 1},
-    [F_CELL] = {"--cell", 1},    [F_SHARD] = {"--shard", 1},
+    [F_CELL] = {"--cell", 1},    [F_SHARD] = {"--shard", 1},   [F_LOCK_TIMEOUT] = {"--lock-timeout", 1},
     [F_HELP] = {"--help", 0},
 };
 
@@ -135,8 +135,10 @@ static int cell_mask(const cli *c, const tcb_config *cfg, unsigned char **mask)
 static int finish_run(const cli *c, const char *run_dir, const tcb_run_stats *st)
 {
     tcb_error err = {0};
-    fprintf(stderr, "cells: %d in all, %d computed, %d already done, %d failed\n", st->cells_total,
-            st->cells_done, st->cells_skipped, st->cells_failed);
+    fprintf(stderr, "cells: %d in all, %d computed, %d already done, %d failed", st->cells_total, st->cells_done,
+            st->cells_skipped, st->cells_failed);
+    if (st->cells_busy) fprintf(stderr, ", %d running in other processes", st->cells_busy);
+    fprintf(stderr, "\n");
     fprintf(stderr, "results: %s\n", run_dir);
     if (!c->set[F_REPORT]) {
         fprintf(stderr, "make the report: tcbench report %s\n", run_dir);
@@ -161,8 +163,15 @@ static int cmd_run(const cli *c)
     tcb_term_progress tp;
     tcb_term_progress_init(&tp, stderr, c->set[F_QUIET] ? 1 : -1);
     tp.verbose = c->set[F_VERBOSE];
-    tcb_run_opts opts = {c->value[F_OUT], c->value[F_ONLY], c->set[F_FORCE],
-                         c->set[F_DRY_RUN] ? (tcb_reporter){0} : tcb_term_progress_reporter(&tp), mask};
+    long long lock_timeout;
+    if (int_option(c, F_LOCK_TIMEOUT, 0, &lock_timeout)) {
+        tcb_config_free(&cfg);
+        free(mask);
+        return 2;
+    }
+    tcb_run_opts opts = {.output = c->value[F_OUT], .only_method = c->value[F_ONLY], .force = c->set[F_FORCE],
+                         .reporter = c->set[F_DRY_RUN] ? (tcb_reporter){0} : tcb_term_progress_reporter(&tp),
+                         .cells = mask, .lock_timeout_s = (double)lock_timeout};
     tcb_run_stats st;
     rc = c->set[F_DRY_RUN] ? tcb_run_dry(&cfg, &opts, stdout, &err) : tcb_run(&cfg, &opts, &st, &err);
     tcb_term_progress_finish(&tp);
@@ -180,7 +189,7 @@ static int cmd_cells(const cli *c)
     tcb_config cfg;
     int rc = load_config(c, &cfg);
     if (rc) return rc;
-    tcb_run_opts opts = {c->value[F_OUT], NULL, 0, {0}, NULL};
+    tcb_run_opts opts = {.output = c->value[F_OUT]};
     rc = tcb_run_list_cells(&cfg, &opts, stdout, &err);
     tcb_config_free(&cfg);
     return rc ? fail(&err) : 0;
@@ -344,15 +353,18 @@ static int cmd_help(const cli *c);
 static const command commands[] = {
     {"run", cmd_run,
      BIT(F_OUT) | BIT(F_ONLY) | BIT(F_FORCE) | BIT(F_QUIET) | BIT(F_REPORT) | BIT(F_THREADS) | BIT(F_VERBOSE) |
-         BIT(F_ROOT) | BIT(F_VARIANT) | BIT(F_DRY_RUN) | BIT(F_CELL) | BIT(F_SHARD),
+         BIT(F_ROOT) | BIT(F_VARIANT) | BIT(F_DRY_RUN) | BIT(F_CELL) | BIT(F_SHARD) | BIT(F_LOCK_TIMEOUT),
      1, 1, "CONFIG",
      "usage: tcbench run CONFIG [--root DATASET=DIR]... [--variant NAME] [--dry-run] [--out DIR]\n"
-     "                  [--only METHOD] [--cell IDS] [--shard I/N|auto] [--threads N] [--force]\n"
-     "                  [--quiet] [--verbose] [--report] [--plugin SO]...\n"
+     "                  [--only METHOD] [--cell IDS] [--shard I/N|auto] [--lock-timeout S]\n"
+     "                  [--threads N] [--force] [--quiet] [--verbose] [--report] [--plugin SO]...\n"
      "\n"
      "Runs every (dataset, sequence, method, seed) cell of the config and writes one\n"
      "result file per cell. Finished cells are skipped, so rerunning a killed run\n"
-     "resumes it.\n"
+     "resumes it. Each cell is computed under a lock (<cell>.json.lock, heartbeat\n"
+     "refreshed while it runs), so any number of 'tcbench run' processes, on any\n"
+     "machines sharing the run directory, can work on one config: a locked cell is\n"
+     "left to its holder, a stale lock is taken over (and said so).\n"
      "\n"
      "options:\n"
      "  --root D=DIR   the data of the config's dataset D (else $TCBENCH_ROOT_<D>, else the\n"
@@ -365,6 +377,8 @@ static const command commands[] = {
      "  --cell IDS     run only these cells (\"3,5-7\"; ids as 'tcbench cells' lists them)\n"
      "  --shard I/N    run only the cells whose id is I modulo N; 'auto' takes I and N from\n"
      "                 a Slurm array task (SLURM_ARRAY_TASK_ID, _MIN/_MAX or _COUNT)\n"
+     "  --lock-timeout S  take over a cell lock whose heartbeat is older than S seconds\n"
+     "                 (default 600; a lock of a dead process on this host at once)\n"
      "  --threads N    threads per cell (default: SLURM_CPUS_PER_TASK under Slurm, else the\n"
      "                 config's \"threads\", else 2); two processes with --only and\n"
      "                 --threads 1 use two cores more evenly\n"

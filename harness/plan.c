@@ -48,18 +48,29 @@ static void probe(const tcb_dataset_spec *d, const char *name, int *n_frames, in
     if (tcb_sequence_probe_objdir(dir, n_frames, n_verts, &err)) *n_frames = *n_verts = 0;
 }
 
-static const char *cell_state(const char *run_dir, const tcb_dataset_spec *d, const char *seq,
-                              const tcb_method_spec *m, int seed)
+/* done, failed, diverged, unreadable, missing, or "running (host pid, age)"
+ * while a lock of a live holder is on a cell without a result. */
+static void cell_state(const char *run_dir, const tcb_dataset_spec *d, const char *seq, const tcb_method_spec *m,
+                       int seed, char *out, size_t size)
 {
-    char path[TCB_PATH_MAX];
+    char path[TCB_PATH_MAX], lock[TCB_PATH_MAX + 8];
     tcb_error err = {0};
-    if (tcb_cell_path(path, sizeof path, run_dir, d->name, seq, m->label, seed, &err) || !tcb_is_file(path))
-        return "missing";
+    snprintf(out, size, "missing");
+    if (tcb_cell_path(path, sizeof path, run_dir, d->name, seq, m->label, seed, &err)) return;
+    tcb_lock_info h;
+    snprintf(lock, sizeof lock, "%s.lock", path);
+    if (!tcb_is_file(path)) {
+        if (!tcb_cell_lock_read(lock, &h))
+            snprintf(out, size, "running (%s pid %ld, heartbeat %.0f s ago)", h.host, h.pid, h.heartbeat_age_s);
+        return;
+    }
     tcb_cell_result c;
-    if (tcb_cell_load(path, &c, &err)) return "unreadable";
-    const char *state = c.status == TCB_CELL_OK ? "done" : tcb_cell_status_name(c.status);
+    if (tcb_cell_load(path, &c, &err)) {
+        snprintf(out, size, "unreadable");
+        return;
+    }
+    snprintf(out, size, "%s", c.status == TCB_CELL_OK ? "done" : tcb_cell_status_name(c.status));
     tcb_cell_free(&c);
-    return state;
 }
 
 static void estimate_cell(const tcb_method_spec *m, const tcb_cost_query *q, tcb_cost_estimate *e)
@@ -113,7 +124,8 @@ static int plan_cell(void *ctx, const tcb_grid_cell *c)
     w->current = c->sequence;
     tcb_cost_estimate e;
     estimate_cell(c->method, &w->q, &e);
-    const char *state = cell_state(w->run_dir, c->dataset, c->sequence->name, c->method, c->seed);
+    char state[TCB_PATH_MAX];
+    cell_state(w->run_dir, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state);
     int runs = w->opts->force || !strcmp(state, "missing") || !strcmp(state, "unreadable");
     char fit[32], eval[32];
     duration_text(e.fit_s, fit, sizeof fit);
@@ -154,8 +166,10 @@ typedef struct list_walk {
 static int list_cell(void *ctx, const tcb_grid_cell *c)
 {
     const list_walk *w = ctx;
+    char state[TCB_PATH_MAX];
+    cell_state(w->run_dir, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state);
     fprintf(w->out, "%5d  %-12s %-20s %-24s %4d  %s\n", c->id, c->dataset->name, c->sequence->name,
-            c->method->label, c->seed, cell_state(w->run_dir, c->dataset, c->sequence->name, c->method, c->seed));
+            c->method->label, c->seed, state);
     return TCB_OK;
 }
 

@@ -261,6 +261,42 @@ static int run_cell(const run_state *st, const seq_ctx *sc, const tcb_method_spe
     return rc;
 }
 
+static int skip_finished(const run_state *st, const tcb_method_spec *m, const seq_ctx *sc, const char *path,
+                         tcb_error *err)
+{
+    int rc = check_existing(path, m, sc->split, err);
+    if (!rc) st->stats->cells_skipped++;
+    return rc;
+}
+
+/* A finished cell is skipped; any other is computed under its lock, unless
+ * another live process holds that (it is then left to it). The lock is
+ * taken before a look at the cell file settles anything, since the holder
+ * may finish it meanwhile. */
+static int claim_and_run(const run_state *st, const seq_ctx *sc, const tcb_method_spec *m, int seed,
+                         const char *path, tcb_error *err)
+{
+    if (!st->opts->force && tcb_is_file(path)) return skip_finished(st, m, sc, path, err);
+    tcb_cell_lock lock;
+    tcb_lock_info holder;
+    char note[512], label[TCB_CELL_LABEL_MAX];
+    double timeout = st->opts->lock_timeout_s > 0 ? st->opts->lock_timeout_s : TCB_LOCK_TIMEOUT_DEFAULT_S;
+    tcb_cell_label(label, sizeof label, sc->dataset->name, sc->seq->name, m->label, seed);
+    int rc = tcb_cell_lock_acquire(&lock, path, timeout, &holder, note, sizeof note, err);
+    if (rc) return rc;
+    if (!lock.held) {
+        st->stats->cells_busy++;
+        tcb_report_log(&st->opts->reporter, TCB_LOG_INFO, "%s: running in %s pid %ld (heartbeat %.0f s ago), left to it",
+                       label, holder.host, holder.pid, holder.heartbeat_age_s);
+        return TCB_OK;
+    }
+    if (note[0]) tcb_report_log(&st->opts->reporter, TCB_LOG_WARN, "%s: %s", label, note);
+    rc = !st->opts->force && tcb_is_file(path) ? skip_finished(st, m, sc, path, err)
+                                                : run_cell(st, sc, m, seed, path, err);
+    tcb_cell_lock_release(&lock);
+    return rc;
+}
+
 /* The cell with this id and method is one the options ask for. */
 static int cell_wanted(const tcb_run_opts *opts, int id, const tcb_method_spec *m)
 {
@@ -295,12 +331,7 @@ static int run_cells(const run_state *st, const seq_ctx *sc, int first, tcb_erro
             int rc = tcb_cell_path(path, sizeof path, st->run_dir, sc->dataset->name,
                                    sc->seq->name, m->label, m->seeds[s], err);
             st->stats->cells_total++;
-            if (!rc && !st->opts->force && tcb_is_file(path)) {
-                rc = check_existing(path, m, sc->split, err);
-                if (!rc) st->stats->cells_skipped++;
-            } else if (!rc) {
-                rc = run_cell(st, sc, m, m->seeds[s], path, err);
-            }
+            if (!rc) rc = claim_and_run(st, sc, m, m->seeds[s], path, err);
             if (rc) return rc;
         }
     }

@@ -3,7 +3,9 @@
  * For each cell: load (cached) sequence, obtain its split, create the method,
  * fit, transfer every evaluation pair, project, score, reconstruct when the
  * method can, and write the cell file atomically. Finished cells are skipped,
- * so rerunning a killed run resumes it and yields the same results. */
+ * so rerunning a killed run resumes it and yields the same results. A cell
+ * is computed under its lock (<cell>.json.lock), so any number of processes
+ * may run one config on one run directory and each cell is computed once. */
 #ifndef TCB_RUNNER_H
 #define TCB_RUNNER_H
 
@@ -23,7 +25,10 @@ typedef struct tcb_run_opts {
     int force;               /* recompute finished cells */
     tcb_reporter reporter;
     const unsigned char *cells; /* [tcb_grid_count] 1: run cell id k; NULL: every cell */
+    double lock_timeout_s;   /* a cell lock whose heartbeat is older is taken over; 0: 600 s */
 } tcb_run_opts;
+
+#define TCB_LOCK_TIMEOUT_DEFAULT_S 600.0
 
 /* The number of cells of the config, numbered 0.. in grid order (datasets,
  * sequences, methods, seeds): an id depends only on the config. */
@@ -38,6 +43,7 @@ int tcb_shard_parse(const char *spec, int n_cells, unsigned char *mask, tcb_erro
 
 typedef struct tcb_run_stats {
     int cells_total, cells_done, cells_skipped, cells_failed;
+    int cells_busy;          /* locked by another live process: left to it */
 } tcb_run_stats;
 
 int tcb_run(const tcb_config *cfg, const tcb_run_opts *opts, tcb_run_stats *stats,

@@ -1,0 +1,170 @@
+/* Cell locks: any number of tcbench processes, on any number of machines
+ * sharing one run directory, compute each cell once.
+ *
+ * A lock is the file <cell>.json.lock holding {"host", "pid", "started"};
+ * its modification time is the heartbeat, refreshed by a thread of the
+ * holder every timeout/4. It is created by link(2) of a complete temporary
+ * file, which is atomic and exclusive on local file systems and on NFS
+ * (O_EXCL was not on NFSv2, and flock does not cross machines). A lock
+ * whose heartbeat is older than the timeout, or whose process is gone on
+ * this host, is taken over; the taker first claims <lock>.takeover the same
+ * way, so two processes finding one stale lock cannot both take it. */
+#include <errno.h>
+#include <fcntl.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "harness/internal.h"
+#include "tcb/fsutil.h"
+#include "tcb/json.h"
+
+#define TAKEOVER_STALE_S 60.0 /* a taker that died mid-takeover */
+
+static void *heartbeat(void *arg)
+{
+    tcb_cell_lock *l = arg;
+    pthread_mutex_lock(&l->mu);
+    while (!l->stop) {
+        struct timespec until;
+        clock_gettime(CLOCK_REALTIME, &until);
+        double period = l->timeout_s / 4 < 1 ? 1 : l->timeout_s / 4;
+        until.tv_sec += (time_t)period;
+        pthread_cond_timedwait(&l->cv, &l->mu, &until);
+        if (!l->stop) utimensat(AT_FDCWD, l->path, NULL, 0);
+    }
+    pthread_mutex_unlock(&l->mu);
+    return NULL;
+}
+
+int tcb_cell_lock_read(const char *path, tcb_lock_info *info)
+{
+    memset(info, 0, sizeof *info);
+    struct stat st;
+    char *text;
+    tcb_error err = {0};
+    if (stat(path, &st) || tcb_read_file(path, &text, NULL, &err)) return -1;
+    cJSON *j = cJSON_Parse(text);
+    free(text);
+    const cJSON *host = cJSON_GetObjectItemCaseSensitive(j, "host");
+    const cJSON *pid = cJSON_GetObjectItemCaseSensitive(j, "pid");
+    const cJSON *started = cJSON_GetObjectItemCaseSensitive(j, "started");
+    int ok = cJSON_IsString(host) && cJSON_IsNumber(pid) && cJSON_IsNumber(started);
+    if (ok) {
+        snprintf(info->host, sizeof info->host, "%s", host->valuestring);
+        info->pid = (long)pid->valuedouble, info->started = started->valuedouble;
+    }
+    cJSON_Delete(j);
+    struct timespec now;
+    clock_gettime(CLOCK_REALTIME, &now);
+    info->heartbeat_age_s = (double)(now.tv_sec - st.st_mtim.tv_sec) + (now.tv_nsec - st.st_mtim.tv_nsec) * 1e-9;
+    info->valid = ok;
+    return 0;
+}
+
+/* Why the holder no longer counts, or NULL while it does. An unreadable
+ * lock counts until its heartbeat is old: it may be in the middle of being
+ * written by a takeover. */
+static const char *stale_reason(const tcb_lock_info *h, double timeout_s)
+{
+    char me[256] = "";
+    gethostname(me, sizeof me - 1);
+    if (h->heartbeat_age_s > timeout_s) return "its heartbeat stopped";
+    if (h->valid && !strcmp(h->host, me) && h->pid > 0 && kill((pid_t)h->pid, 0) && errno == ESRCH)
+        return "its process is gone";
+    return NULL;
+}
+
+static int write_lock_temp(const char *path, char *tmp, size_t size, tcb_error *err)
+{
+    char host[256] = "";
+    gethostname(host, sizeof host - 1);
+    struct timespec now;
+    clock_gettime(CLOCK_REALTIME, &now);
+    char text[512];
+    int n = snprintf(text, sizeof text, "{\"host\": \"%s\", \"pid\": %ld, \"started\": %.3f}\n", host, (long)getpid(),
+                     (double)now.tv_sec + now.tv_nsec * 1e-9);
+    int rc = tcb_temp_path_for(path, tmp, size, err);
+    if (!rc) {
+        FILE *f = fopen(tmp, "wb");
+        if (!f || fwrite(text, 1, (size_t)n, f) != (size_t)n || fclose(f))
+            rc = tcb_fail(err, TCB_ERR_IO, "%s: cannot write: %s", tmp, strerror(errno));
+    }
+    return rc;
+}
+
+/* Takes over the stale lock `path` holding `old`: 1 taken, 0 somebody else
+ * is at it or the lock changed meanwhile. */
+static int take_over(const char *path, const char *tmp, const tcb_lock_info *old)
+{
+    char guard[TCB_PATH_MAX + 16];
+    snprintf(guard, sizeof guard, "%s.takeover", path);
+    if (link(tmp, guard)) {
+        struct stat st;
+        if (errno != EEXIST || stat(guard, &st) || difftime(time(NULL), st.st_mtime) < TAKEOVER_STALE_S) return 0;
+        unlink(guard); /* its taker died: the next attempt retries */
+        return 0;
+    }
+    tcb_lock_info now;
+    int same = !tcb_cell_lock_read(path, &now) && now.pid == old->pid && now.started == old->started &&
+               !strcmp(now.host, old->host);
+    int taken = same && !unlink(path) && !link(tmp, path);
+    unlink(guard);
+    return taken;
+}
+
+int tcb_cell_lock_acquire(tcb_cell_lock *l, const char *cell_path, double timeout_s, tcb_lock_info *holder,
+                          char *note, size_t note_size, tcb_error *err)
+{
+    memset(l, 0, sizeof *l);
+    memset(holder, 0, sizeof *holder);
+    note[0] = '\0';
+    l->timeout_s = timeout_s;
+    char tmp[TCB_PATH_MAX];
+    int rc = tcb_path_join(l->path, sizeof l->path, err, "%s.lock", cell_path);
+    if (!rc) rc = write_lock_temp(l->path, tmp, sizeof tmp, err);
+    if (rc) return rc;
+    int claimed = !link(tmp, l->path);
+    if (!claimed && errno != EEXIST) {
+        rc = tcb_fail(err, TCB_ERR_IO, "%s: cannot create the lock: %s", l->path, strerror(errno));
+    } else if (!claimed && !tcb_cell_lock_read(l->path, holder)) {
+        const char *why = stale_reason(holder, timeout_s);
+        if (why && (claimed = take_over(l->path, tmp, holder)))
+            snprintf(note, note_size, "took over the lock of %s pid %ld: %s (heartbeat %.0f s old)", holder->host,
+                     holder->pid, why, holder->heartbeat_age_s);
+    } else if (!claimed) {
+        claimed = !link(tmp, l->path); /* released between our link and our read */
+    }
+    unlink(tmp);
+    if (rc || !claimed) return rc;
+    l->held = 1;
+    pthread_mutex_init(&l->mu, NULL);
+    pthread_cond_init(&l->cv, NULL);
+    if (pthread_create(&l->thread, NULL, heartbeat, l)) {
+        tcb_cell_lock_release(l);
+        return tcb_fail(err, TCB_ERR_INTERNAL, "%s: cannot start the heartbeat", l->path);
+    }
+    l->beating = 1;
+    return TCB_OK;
+}
+
+void tcb_cell_lock_release(tcb_cell_lock *l)
+{
+    if (!l->held) return;
+    if (l->beating) {
+        pthread_mutex_lock(&l->mu);
+        l->stop = 1;
+        pthread_cond_signal(&l->cv);
+        pthread_mutex_unlock(&l->mu);
+        pthread_join(l->thread, NULL);
+    }
+    pthread_cond_destroy(&l->cv);
+    pthread_mutex_destroy(&l->mu);
+    unlink(l->path);
+    l->held = l->beating = 0;
+}
