@@ -162,13 +162,13 @@ int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, 
 }
 
 int tcb_harness_obtain_split(const tcb_config *cfg, const tcb_dataset_spec *d,
-                             const tcb_sequence_spec *s, int n_frames, char *path, size_t size,
-                             tcb_split *split, tcb_error *err)
+                             const tcb_sequence_spec *s, const tcb_sequence *seq, char *path,
+                             size_t size, tcb_split *split, tcb_error *err)
 {
     int rc = tcb_path_join(path, size, err, "%s/%s/%s.json", cfg->splits_dir, d->name, s->name);
     if (rc) return rc;
-    return tcb_split_obtain(path, d->name, s->name, s->role, n_frames, cfg->eval_pairs,
-                            cfg->split_seed, split, err);
+    return tcb_split_obtain(path, d->name, s->name, s->role, seq->n_frames, seq->blocks, seq->n_blocks,
+                            cfg->eval_pairs, cfg->split_seed, split, err);
 }
 
 int tcb_harness_work_paths(const char *run_dir, const char *dataset, const char *sequence,
@@ -295,8 +295,7 @@ static int run_sequence(const run_state *st, const tcb_dataset_spec *d, const tc
     int rc = tcb_harness_load_sequence(st->cfg, d, s->name, &seq, err);
     if (rc) return rc;
     seq_ctx sc = {d, &seq, &split, split_path, tcb_now_seconds() - t0};
-    rc = tcb_harness_obtain_split(st->cfg, d, s, seq.n_frames, split_path, sizeof split_path,
-                                  &split, err);
+    rc = tcb_harness_obtain_split(st->cfg, d, s, &seq, split_path, sizeof split_path, &split, err);
     if (!rc) rc = run_cells(st, &sc, err);
     tcb_split_free(&split);
     tcb_sequence_free(&seq);
