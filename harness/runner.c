@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "harness/internal.h"
+#include "tcb/dfaust.h"
 #include "tcb/fsutil.h"
 #include "tcb/registry.h"
 #include "tcb/synth.h"
@@ -144,6 +145,8 @@ int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, 
     if (d->source == TCB_SOURCE_SYNTHETIC) {
         rc = tcb_synth_generate(name, d->seed, d->frames, seq, err);
         if (!rc) rc = tcb_sequence_prepare(seq, &lo, err);
+    } else if (d->source == TCB_SOURCE_DFAUST) {
+        rc = tcb_sequence_load_dfaust(d->root, name, d->subjects, d->n_subjects, &lo, seq, err);
     } else {
         char dir[TCB_PATH_MAX];
         rc = tcb_path_join(dir, sizeof dir, err, "%s/%s", d->root, name);
@@ -304,7 +307,7 @@ static int run_sequence(const run_state *st, const tcb_dataset_spec *d, const tc
 
 static int root_missing(const tcb_dataset_spec *d)
 {
-    return d->source == TCB_SOURCE_OBJDIR && !tcb_is_dir(d->root);
+    return d->source != TCB_SOURCE_SYNTHETIC && !tcb_is_dir(d->root);
 }
 
 /* Missing data is found before any cell runs, not hours into the run. */
