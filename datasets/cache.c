@@ -1,42 +1,43 @@
-/* HDF5 cache of a loaded sequence, so benchmark runs skip OBJ parsing.
+/* HDF5 cache of a loaded sequence, so benchmark runs skip parsing.
  *
  * Layout (one file per sequence and options):
  *   /verts      float32 [F][V][3]     /faces   int32 [NF][3]
  *   /areas      float64 [F]           /norm_shift float64 [F][3]
  *   /pools      float32 [F][P][3]     (absent when P = 0)
  *   /yaw        float64 [F]           (absent when not rotation-aligned)
+ *   /blocks     compound {name: string[64], start, n_frames: int32} [B]
+ *               (absent for a sequence without blocks)
  *   attributes on /: format_version, key, name, norm, norm_scale.
  * The file is written under a temporary name and renamed into place. */
 #include <errno.h>
 #include <fcntl.h>
 #include <hdf5.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-#include "datasets/objdir.h"
+#include "datasets/cache.h"
+#include "datasets/h5util.h"
+#include "datasets/strbuf.h"
 #include "tcb/fsutil.h"
 #include "tcb/sequence.h"
 
-/* Bump when the layout or the meaning of any field changes. */
-#define CACHE_FORMAT_VERSION 3
+/* Bump when the layout or the meaning of any field changes (4: /blocks). */
+#define CACHE_FORMAT_VERSION 4
 
-/* HDF5 prints its error stack by default; library code must not print, so
- * every entry point silences it and restores the caller's handler after. */
-typedef struct h5_quiet {
-    H5E_auto2_t func;
-    void *data;
-} h5_quiet;
-
-static void quiet_begin(h5_quiet *q)
+/* tcb_block as an HDF5 compound, the same in memory and in the file. */
+static hid_t block_type(void)
 {
-    H5Eget_auto2(H5E_DEFAULT, &q->func, &q->data);
-    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    hid_t str = H5Tcopy(H5T_C_S1), t = H5Tcreate(H5T_COMPOUND, sizeof(tcb_block));
+    int bad = str < 0 || t < 0 || H5Tset_size(str, TCB_BLOCK_NAME_MAX) < 0 ||
+              H5Tinsert(t, "name", HOFFSET(tcb_block, name), str) < 0 ||
+              H5Tinsert(t, "start", HOFFSET(tcb_block, start), H5T_NATIVE_INT) < 0 ||
+              H5Tinsert(t, "n_frames", HOFFSET(tcb_block, n_frames), H5T_NATIVE_INT) < 0;
+    if (str >= 0) H5Tclose(str);
+    if (bad && t >= 0) H5Tclose(t);
+    return bad ? -1 : t;
 }
-
-static void quiet_end(const h5_quiet *q) { H5Eset_auto2(H5E_DEFAULT, q->func, q->data); }
 
 /* ---- writing ---------------------------------------------------------- */
 
@@ -87,6 +88,12 @@ static int write_contents(hid_t file, const tcb_sequence *s, const char *key)
     if (!bad && s->pool_size > 0)
         bad = write_array(file, "pools", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, 3, pool_dims, s->pools);
     if (!bad && s->yaw) bad = write_array(file, "yaw", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, &F, s->yaw);
+    if (!bad && s->n_blocks > 0) {
+        hsize_t B = (hsize_t)s->n_blocks;
+        hid_t type = block_type();
+        bad = type < 0 || write_array(file, "blocks", type, type, 1, &B, s->blocks);
+        if (type >= 0) H5Tclose(type);
+    }
     return bad ? -1 : 0;
 }
 
@@ -107,8 +114,8 @@ int tcb_sequence_cache_save(const char *path, const tcb_sequence *s, const char 
     char tmp[TCB_PATH_MAX];
     int rc = tcb_temp_path_for(path, tmp, sizeof tmp, err);
     if (rc) return rc;
-    h5_quiet q;
-    quiet_begin(&q);
+    tcb_h5_quiet q;
+    tcb_h5_quiet_begin(&q);
     /* 1.8+ object headers: the key attribute may exceed the 64 KiB limit of
      * the oldest format on long sequences. */
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
@@ -118,7 +125,7 @@ int tcb_sequence_cache_save(const char *path, const tcb_sequence *s, const char 
     int bad = file < 0 || write_contents(file, s, key) != 0;
     if (file >= 0 && H5Fclose(file) < 0) bad = 1;
     if (fapl >= 0) H5Pclose(fapl);
-    quiet_end(&q);
+    tcb_h5_quiet_end(&q);
     if (bad || fsync_path(tmp) != 0) {
         unlink(tmp);
         return tcb_fail(err, TCB_ERR_IO, "%s: cannot write sequence cache", path);
@@ -167,15 +174,10 @@ static char *read_attr_string(hid_t obj, const char *name)
 /* dims[0..rank) of dataset `name`; -1 when absent or of another rank. */
 static int array_dims(hid_t file, const char *name, int rank, hsize_t *dims)
 {
-    if (H5Lexists(file, name, H5P_DEFAULT) <= 0) return -1;
-    hid_t ds = H5Dopen2(file, name, H5P_DEFAULT);
-    if (ds < 0) return -1;
-    hid_t space = H5Dget_space(ds);
-    int ok = space >= 0 && H5Sget_simple_extent_ndims(space) == rank &&
-             H5Sget_simple_extent_dims(space, dims, NULL) == rank;
-    if (space >= 0) H5Sclose(space);
-    H5Dclose(ds);
-    return ok ? 0 : -1;
+    tcb_h5_shape sh;
+    if (tcb_h5_shape_of(file, name, &sh) != 0 || sh.rank != rank) return -1;
+    memcpy(dims, sh.dims, (size_t)rank * sizeof *dims);
+    return 0;
 }
 
 /* Reads dataset `name` into buf after checking it has exactly `dims`. */
@@ -240,6 +242,24 @@ static int alloc_from_shapes(hid_t file, const char *path, tcb_sequence *out, tc
     return TCB_OK;
 }
 
+/* The optional /blocks, checked to tile the frames. */
+static int read_blocks(hid_t file, const char *path, tcb_sequence *out, tcb_error *err)
+{
+    if (H5Lexists(file, "blocks", H5P_DEFAULT) <= 0) return TCB_OK;
+    hsize_t B;
+    if (array_dims(file, "blocks", 1, &B) != 0 || B < 1 || B > (hsize_t)out->n_frames)
+        return corrupt(path, "bad blocks", err);
+    out->blocks = calloc((size_t)B, sizeof *out->blocks);
+    if (!out->blocks) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", path);
+    out->n_blocks = (int)B;
+    hid_t type = block_type();
+    int bad = type < 0 || read_array(file, "blocks", type, 1, &B, out->blocks) != 0;
+    if (type >= 0) H5Tclose(type);
+    if (bad || tcb_blocks_check(out->blocks, out->n_blocks, out->n_frames, "blocks", NULL) != TCB_OK)
+        return corrupt(path, "bad blocks", err);
+    return TCB_OK;
+}
+
 static int read_contents(hid_t file, const char *path, tcb_sequence *out, tcb_error *err)
 {
     int rc = alloc_from_shapes(file, path, out, err);
@@ -262,7 +282,7 @@ static int read_contents(hid_t file, const char *path, tcb_sequence *out, tcb_er
     /* Bad ids would turn into out-of-bounds reads far from here. */
     for (size_t i = 0; i < 3 * (size_t)out->n_faces; i++)
         if (out->faces[i] < 0 || out->faces[i] >= out->n_verts) return corrupt(path, "face index out of range", err);
-    return TCB_OK;
+    return read_blocks(file, path, out, err);
 }
 
 int tcb_sequence_cache_load(const char *path, const char *key, tcb_sequence *out, tcb_error *err)
@@ -271,60 +291,29 @@ int tcb_sequence_cache_load(const char *path, const char *key, tcb_sequence *out
     out->input_points = TCB_DEFAULT_INPUT_POINTS;
     if (access(path, R_OK) != 0)
         return tcb_fail(err, TCB_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
-    h5_quiet q;
-    quiet_begin(&q);
+    tcb_h5_quiet q;
+    tcb_h5_quiet_begin(&q);
     hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     int rc = file < 0 ? corrupt(path, "not an HDF5 file", err) : check_key(file, path, key, err);
     if (!rc) rc = read_contents(file, path, out, err);
     if (file >= 0) H5Fclose(file);
-    quiet_end(&q);
+    tcb_h5_quiet_end(&q);
     if (rc) tcb_sequence_free(out);
     return rc;
 }
 
-/* ---- OBJ directory + cache ------------------------------------------- */
+/* ---- loading through the cache --------------------------------------- */
 
-typedef struct strbuf {
-    char *s;
-    size_t len, cap;
-} strbuf;
-
-static int sb_printf(strbuf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static int sb_printf(strbuf *b, const char *fmt, ...)
+/* Everything the cached arrays depend on (cache.h): the format, the name
+ * (it seeds the pools), the options and the source. */
+static int build_key(const char *name, const tcb_load_opts *o, int pool_size, const char *source,
+                     tcb_strbuf *key)
 {
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(NULL, 0, fmt, ap);
-    va_end(ap);
-    if (n < 0) return -1;
-    if (b->len + (size_t)n + 1 > b->cap) {
-        size_t cap = b->cap ? b->cap : 1024;
-        while (cap < b->len + (size_t)n + 1) cap *= 2;
-        char *p = realloc(b->s, cap);
-        if (!p) return -1;
-        b->s = p;
-        b->cap = cap;
-    }
-    va_start(ap, fmt);
-    vsnprintf(b->s + b->len, b->cap - b->len, fmt, ap);
-    va_end(ap);
-    b->len += (size_t)n;
-    return 0;
-}
-
-/* Everything the cached arrays depend on: a change to any frame file (name,
- * size, mtime), to the options, the name (it seeds the pools) or the format
- * makes a different key. */
-static int build_key(const char *name, const tcb_load_opts *o, int pool_size, const tcb_objdir_frame *frames,
-                     int n, strbuf *key)
-{
-    if (sb_printf(key, "tcbench sequence cache v%d\nname=%s\nnorm=%d pool_size=%d pool_seed=%llu align=%d\n",
-                  CACHE_FORMAT_VERSION, name, (int)o->norm, pool_size, (unsigned long long)o->pool_seed,
-                  o->align_samples))
-        return -1;
-    for (int i = 0; i < n; i++)
-        if (sb_printf(key, "%s %lld %lld\n", frames[i].name, frames[i].size, frames[i].mtime_ns)) return -1;
-    return 0;
+    return tcb_sb_printf(key,
+                         "tcbench sequence cache v%d\nname=%s\n"
+                         "norm=%d pool_size=%d pool_seed=%llu align=%d\n%s",
+                         CACHE_FORMAT_VERSION, name, (int)o->norm, pool_size,
+                         (unsigned long long)o->pool_seed, o->align_samples, source);
 }
 
 static uint64_t fnv1a(const char *s)
@@ -334,22 +323,26 @@ static uint64_t fnv1a(const char *s)
     return h;
 }
 
-static int parse_and_prepare(const char *dir, const tcb_objdir_frame *frames, int n, const char *name,
-                             const tcb_load_opts *o, tcb_sequence *out, tcb_error *err)
+static int read_and_prepare(const char *name, const tcb_load_opts *o, tcb_raw_reader read, const void *ctx,
+                            tcb_sequence *out, tcb_error *err)
 {
-    int rc = tcb_objdir_read(dir, frames, n, name, out, err);
+    int rc = read(ctx, name, out, err);
     if (!rc) rc = tcb_sequence_prepare(out, o, err);
     if (rc) tcb_sequence_free(out);
     return rc;
 }
 
-static int load_via_cache(const char *dir, const tcb_objdir_frame *frames, int n, const char *name,
-                          const tcb_load_opts *o, int pool_size, tcb_sequence *out, tcb_error *err)
+int tcb_cache_load(const char *name, const tcb_load_opts *opts, const char *source, tcb_raw_reader read,
+                   const void *ctx, tcb_sequence *out, tcb_error *err)
 {
-    strbuf key = {0};
-    if (build_key(name, o, pool_size, frames, n, &key)) {
+    memset(out, 0, sizeof *out);
+    static const tcb_load_opts defaults = {TCB_NORM_NONE, TCB_DEFAULT_POOL_SIZE, 0, NULL, 0};
+    const tcb_load_opts *o = opts ? opts : &defaults;
+    if (!o->cache_dir || !*o->cache_dir) return read_and_prepare(name, o, read, ctx, out, err);
+    tcb_strbuf key = {0};
+    if (build_key(name, o, o->pool_size ? o->pool_size : TCB_DEFAULT_POOL_SIZE, source, &key)) {
         free(key.s);
-        return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", dir);
+        return tcb_fail(err, TCB_ERR_NOMEM, "sequence %s: out of memory", name);
     }
     char path[TCB_PATH_MAX];
     int rc = tcb_path_join(path, sizeof path, err, "%s/%s-%016llx.h5", o->cache_dir, name,
@@ -359,32 +352,8 @@ static int load_via_cache(const char *dir, const tcb_objdir_frame *frames, int n
         free(key.s);
         return TCB_OK;
     }
-    if (!rc) rc = parse_and_prepare(dir, frames, n, name, o, out, err);
+    if (!rc) rc = read_and_prepare(name, o, read, ctx, out, err);
     if (!rc && (rc = tcb_sequence_cache_save(path, out, key.s, err))) tcb_sequence_free(out);
     free(key.s);
-    return rc;
-}
-
-int tcb_sequence_load_objdir(const char *dir, const char *name, const tcb_load_opts *opts, tcb_sequence *out,
-                             tcb_error *err)
-{
-    memset(out, 0, sizeof *out);
-    static const tcb_load_opts defaults = {TCB_NORM_NONE, TCB_DEFAULT_POOL_SIZE, 0, NULL, 0};
-    const tcb_load_opts *o = opts ? opts : &defaults;
-    int pool_size = o->pool_size ? o->pool_size : TCB_DEFAULT_POOL_SIZE;
-    char default_name[TCB_NAME_MAX];
-    if (!name) {
-        int rc = tcb_objdir_default_name(dir, default_name, err);
-        if (rc) return rc;
-        name = default_name;
-    }
-    tcb_objdir_frame *frames;
-    int n, rc = tcb_objdir_list(dir, &frames, &n, err);
-    if (rc) return rc;
-    if (o->cache_dir && *o->cache_dir)
-        rc = load_via_cache(dir, frames, n, name, o, pool_size, out, err);
-    else
-        rc = parse_and_prepare(dir, frames, n, name, o, out, err);
-    free(frames);
     return rc;
 }

@@ -1,4 +1,4 @@
-/* A directory of OBJ frames <-> a tcb_sequence. */
+/* A directory of OBJ frames <-> a tcb_sequence, loaded through the cache. */
 #include "datasets/objdir.h"
 
 #include <dirent.h>
@@ -9,6 +9,8 @@
 #include <strings.h>
 #include <sys/stat.h>
 
+#include "datasets/cache.h"
+#include "datasets/strbuf.h"
 #include "tcb/fsutil.h"
 #include "tcb/mesh.h"
 
@@ -198,4 +200,42 @@ int tcb_sequence_write_objdir(const tcb_sequence *s, const char *dir, tcb_error 
         if (rc) return rc;
     }
     return TCB_OK;
+}
+
+typedef struct objdir_source {
+    const char *dir;
+    const tcb_objdir_frame *frames;
+    int n;
+} objdir_source;
+
+static int read_listed(const void *ctx, const char *name, tcb_sequence *out, tcb_error *err)
+{
+    const objdir_source *src = ctx;
+    return tcb_objdir_read(src->dir, src->frames, src->n, name, out, err);
+}
+
+int tcb_sequence_load_objdir(const char *dir, const char *name, const tcb_load_opts *opts, tcb_sequence *out,
+                             tcb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    char default_name[TCB_NAME_MAX];
+    if (!name) {
+        int rc = tcb_objdir_default_name(dir, default_name, err);
+        if (rc) return rc;
+        name = default_name;
+    }
+    tcb_objdir_frame *frames;
+    int n, rc = tcb_objdir_list(dir, &frames, &n, err);
+    if (rc) return rc;
+    /* The cache key names every frame file as listed, the list then parsed:
+     * the two cannot disagree. */
+    tcb_strbuf key = {0};
+    for (int i = 0; i < n && !rc; i++)
+        if (tcb_sb_printf(&key, "%s %lld %lld\n", frames[i].name, frames[i].size, frames[i].mtime_ns))
+            rc = tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", dir);
+    objdir_source src = {dir, frames, n};
+    if (!rc) rc = tcb_cache_load(name, opts, key.s, read_listed, &src, out, err);
+    free(key.s);
+    free(frames);
+    return rc;
 }

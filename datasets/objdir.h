@@ -1,6 +1,4 @@
-/* Private to datasets/: the frame files of an OBJ directory. Shared by the
- * reader (objdir.c) and the cache (cache.c), whose key is built from the
- * same listing that is then parsed, so the two cannot disagree. */
+/* Private to datasets/: the frame files of an OBJ directory (objdir.c). */
 #ifndef TCB_DATASETS_OBJDIR_H
 #define TCB_DATASETS_OBJDIR_H
 

@@ -2,7 +2,8 @@
  * the first frame i, draw the second frame j ≠ i uniformly from a range R.
  * The authors draw from R and reject j == i up to 100 times; drawing directly
  * from R \ {i} gives the same distribution without the (i, i) fallback,
- * which only a one-frame R could reach. */
+ * which only a one-frame R could reach. DFAUST's datasets concatenate the
+ * subjects' blocks; the windows stay inside i's block, `random` does not. */
 #include "tcb/split.h"
 
 #include <string.h>
@@ -26,21 +27,21 @@ static int draw_other(int lo, int hi, int i, tcb_rng *rng)
     return j >= i ? j + 1 : j;
 }
 
-/* Returns j, or −1 when no j exists (fewer than 2 frames, i out of range,
- * delta < 1 in NEIGHBORS mode): the caller's error to report. */
-int tcb_pair_sample(tcb_pair_mode mode, int delta, int n_frames, int i, tcb_rng *rng)
+/* Returns j, or −1 when no j exists: the caller's error to report. */
+int tcb_pair_sample(tcb_pair_mode mode, int delta, int n_frames, int lo, int hi, int i, tcb_rng *rng)
 {
-    if (n_frames < 2 || i < 0 || i >= n_frames) return -1;
+    if (lo < 0 || hi > n_frames || i < lo || i >= hi || hi - lo < 2) return -1;
     switch (mode) {
     case TCB_PAIRS_NEIGHBORS: {
         if (delta < 1) return -1;
-        /* R = [max(0, i − δ), min(n, i + δ + 1)), written to avoid overflow */
-        int lo = i > delta ? i - delta : 0;
-        int hi = n_frames - i > delta ? i + delta + 1 : n_frames;
-        return draw_other(lo, hi, i, rng);
+        /* R = [max(lo, i − δ), min(hi, i + δ + 1)), written to avoid overflow */
+        int a = i - lo > delta ? i - delta : lo;
+        int b = hi - i > delta ? i + delta + 1 : hi;
+        return draw_other(a, b, i, rng);
     }
-    case TCB_PAIRS_RANDOM:
-    case TCB_PAIRS_WITHIN_SEQ: return draw_other(0, n_frames, i, rng);
+    /* as the authors' code: over the whole dataset, across blocks (subjects) */
+    case TCB_PAIRS_RANDOM: return draw_other(0, n_frames, i, rng);
+    case TCB_PAIRS_WITHIN_SEQ: return draw_other(lo, hi, i, rng);
     }
     return -1;
 }

@@ -45,6 +45,7 @@ void tcb_sequence_free(tcb_sequence *s)
     free(s->pools);
     free(s->norm_shift);
     free(s->yaw);
+    free(s->blocks);
     memset(s, 0, sizeof *s);
 }
 

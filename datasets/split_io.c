@@ -1,9 +1,13 @@
 /* Split files: JSON, format "tcbench-split/1".
  *   { "format": "tcbench-split/1", "dataset": "anim", "sequence": "cat_walk",
- *     "role": "validation", "n_frames": 35, "seed": 2021, "n_pairs": 500,
- *     "pairs": [[i, j], ...] }
- * Loading checks every key, type and pair, so a hand-edited or truncated
- * file fails with the file and key named instead of skewing an evaluation. */
+ *     "role": "validation", "n_frames": 35,
+ *     "blocks": [ { "name": "50002", "start": 0, "n_frames": 120 }, ... ],
+ *     "seed": 2021, "n_pairs": 500, "pairs": [[i, j], ...] }
+ * "blocks" (the sequence's blocks, tcb/block.h) is written only for a
+ * sequence that has them (DFAUST), so single-block files are unchanged.
+ * Loading checks every key, type and pair (both frames of a pair in one
+ * block), so a hand-edited or truncated file fails with the file and key
+ * named instead of skewing an evaluation. */
 #include "tcb/split.h"
 
 #include <limits.h>
@@ -12,10 +16,26 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "tcb/fsutil.h"
 #include "tcb/json.h"
 
 #define SPLIT_FORMAT "tcbench-split/1"
 #define SPLIT_SEED_MAX 9007199254740992LL /* 2^53: exact in a JSON number */
+
+static cJSON *blocks_to_json(const tcb_split *s)
+{
+    cJSON *arr = cJSON_CreateArray();
+    int ok = arr != NULL;
+    for (int k = 0; ok && k < s->n_blocks; k++) {
+        cJSON *b = cJSON_CreateObject();
+        ok = b && cJSON_AddItemToArray(arr, b) && cJSON_AddStringToObject(b, "name", s->blocks[k].name) &&
+             cJSON_AddNumberToObject(b, "start", s->blocks[k].start) &&
+             cJSON_AddNumberToObject(b, "n_frames", s->blocks[k].n_frames);
+    }
+    if (ok) return arr;
+    cJSON_Delete(arr);
+    return NULL;
+}
 
 static cJSON *split_to_json(const tcb_split *s)
 {
@@ -27,9 +47,13 @@ static cJSON *split_to_json(const tcb_split *s)
              cJSON_AddStringToObject(root, "dataset", s->dataset) &&
              cJSON_AddStringToObject(root, "sequence", s->sequence) &&
              cJSON_AddStringToObject(root, "role", tcb_role_name(s->role)) &&
-             cJSON_AddNumberToObject(root, "n_frames", s->n_frames) &&
-             cJSON_AddRawToObject(root, "seed", seed) &&
-             cJSON_AddNumberToObject(root, "n_pairs", s->n_pairs);
+             cJSON_AddNumberToObject(root, "n_frames", s->n_frames);
+    if (ok && s->n_blocks > 0) {
+        cJSON *blocks = blocks_to_json(s);
+        ok = blocks && cJSON_AddItemToObject(root, "blocks", blocks);
+    }
+    ok = ok && cJSON_AddRawToObject(root, "seed", seed) &&
+         cJSON_AddNumberToObject(root, "n_pairs", s->n_pairs);
     for (int p = 0; ok && p < s->n_pairs; p++) {
         cJSON *pair = cJSON_CreateIntArray(s->pairs + 2 * p, 2);
         ok = pair && cJSON_AddItemToArray(pairs, pair);
@@ -68,8 +92,8 @@ static int load_name(const cJSON *root, const char *key, const char *where, char
 
 static int load_header(const cJSON *root, const char *path, tcb_split *out, tcb_error *err)
 {
-    static const char *const keys[] = {"format", "dataset", "sequence", "role", "n_frames",
-                                       "seed",   "n_pairs", "pairs",    NULL};
+    static const char *const keys[] = {"format", "dataset", "sequence", "role",  "n_frames",
+                                       "blocks", "seed",    "n_pairs",  "pairs", NULL};
     const char *format, *role;
     long long n_frames, seed, n_pairs;
     int rc = tcb_json_expect_keys(root, path, keys, err);
@@ -92,6 +116,41 @@ static int load_header(const cJSON *root, const char *path, tcb_split *out, tcb_
     out->seed = (uint64_t)seed;
     out->n_pairs = (int)n_pairs;
     return TCB_OK;
+}
+
+static int load_block(const cJSON *o, const char *where, tcb_block *b, tcb_error *err)
+{
+    static const char *const keys[] = {"name", "start", "n_frames", NULL};
+    long long start, n_frames;
+    int rc = tcb_json_expect_keys(o, where, keys, err);
+    if (!rc) rc = load_name(o, "name", where, b->name, sizeof b->name, err);
+    if (!rc) rc = tcb_json_int(o, "start", where, 1, 0, 0, INT_MAX, &start, err);
+    if (!rc) rc = tcb_json_int(o, "n_frames", where, 1, 0, 0, INT_MAX, &n_frames, err);
+    if (rc) return rc;
+    b->start = (int)start, b->n_frames = (int)n_frames;
+    return TCB_OK;
+}
+
+/* The optional "blocks", checked against n_frames (tcb_blocks_check). */
+static int load_blocks(const cJSON *root, const char *path, tcb_split *out, tcb_error *err)
+{
+    const cJSON *arr = cJSON_GetObjectItemCaseSensitive(root, "blocks");
+    if (!arr) return TCB_OK;
+    char where[TCB_PATH_MAX + 32];
+    snprintf(where, sizeof where, "%s.blocks", path);
+    int n = cJSON_IsArray(arr) ? cJSON_GetArraySize(arr) : 0;
+    if (n < 1) return tcb_fail(err, TCB_ERR_INPUT, "%s: expected a non-empty array of blocks", where);
+    out->blocks = calloc((size_t)n, sizeof *out->blocks);
+    if (!out->blocks) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", path);
+    out->n_blocks = n;
+    int k = 0;
+    for (const cJSON *b = arr->child; b; b = b->next, k++) {
+        char bw[TCB_PATH_MAX + 48];
+        snprintf(bw, sizeof bw, "%s[%d]", where, k);
+        int rc = load_block(b, bw, &out->blocks[k], err);
+        if (rc) return rc;
+    }
+    return tcb_blocks_check(out->blocks, n, out->n_frames, where, err);
 }
 
 /* One frame index of pairs[p]: an integer in [0, n_frames). */
@@ -129,6 +188,11 @@ static int load_pairs(const cJSON *root, const char *path, tcb_split *out, tcb_e
         if (rc) return rc;
         if (ij[0] == ij[1])
             return tcb_fail(err, TCB_ERR_INPUT, "%s.pairs[%d]: i == j (%d)", path, p, (int)ij[0]);
+        int lo, hi;
+        tcb_block_find(out->blocks, out->n_blocks, out->n_frames, ij[0], &lo, &hi);
+        if (ij[1] < lo || ij[1] >= hi)
+            return tcb_fail(err, TCB_ERR_INPUT, "%s.pairs[%d]: frames %d and %d are in different blocks",
+                            path, p, (int)ij[0], (int)ij[1]);
     }
     return TCB_OK;
 }
@@ -140,6 +204,7 @@ int tcb_split_load(const char *path, tcb_split *out, tcb_error *err)
     int rc = tcb_json_load(path, &root, err);
     if (rc) return rc;
     rc = load_header(root, path, out, err);
+    if (!rc) rc = load_blocks(root, path, out, err);
     if (!rc) rc = load_pairs(root, path, out, err);
     cJSON_Delete(root);
     if (rc) tcb_split_free(out);

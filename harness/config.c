@@ -26,10 +26,14 @@ static const char *const synthetic_keys[] = {"name", "source", "seed", "frames",
                                              "align_rotation", "align_samples", "sampling", "sequences", NULL};
 static const char *const objdir_keys[] = {"name", "source", "root", "optional", "normalization",
                                           "align_rotation", "align_samples", "sampling", "sequences", NULL};
+/* No rotation alignment: it chains each frame to the previous one, which
+ * across the subjects' blocks would be meaningless, and DFAUST has none. */
+static const char *const dfaust_keys[] = {"name", "source", "root", "optional", "normalization",
+                                          "sampling", "subjects", "sequences", NULL};
 static const char *const sequence_keys[] = {"name", "role", NULL};
 static const char *const method_keys[] = {"name", "method", "params", "seeds", "datasets", NULL};
 
-const char *const tcb_config_source_names[] = {"synthetic", "objdir", NULL};
+const char *const tcb_config_source_names[] = {"synthetic", "objdir", "dfaust", NULL};
 const char *const tcb_config_norm_names[] = {"none", "first_frame", "per_frame", NULL};
 const char *const tcb_config_sampling_names[] = {"without_replacement", "with_replacement", NULL};
 
@@ -141,6 +145,35 @@ static int parse_sequences(const cJSON *o, const char *where, tcb_dataset_spec *
     return TCB_OK;
 }
 
+/* dfaust "subjects": distinct ids, each a valid name (they key datasets). */
+static int parse_subjects(const cJSON *o, const char *where, tcb_dataset_spec *d, tcb_error *err)
+{
+    const cJSON *arr;
+    int rc = get_array(o, "subjects", where, 0, &arr, err);
+    if (rc || !arr) return rc;
+    int n = cJSON_GetArraySize(arr);
+    if (n == 0) return tcb_fail(err, TCB_ERR_INPUT, "%s.subjects: must list at least one subject", where);
+    if (!(d->subjects = calloc((size_t)n, sizeof *d->subjects)))
+        return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", where);
+    char key[32];
+    for (int k = 0; k < n; k++) {
+        const cJSON *s = cJSON_GetArrayItem(arr, k);
+        snprintf(key, sizeof key, "subjects[%d]", k);
+        if (!cJSON_IsString(s))
+            return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: expected a subject id string", where, key);
+        rc = check_name(s->valuestring, TCB_BLOCK_NAME_MAX, where, key, err);
+        if (rc) return rc;
+        for (int m = 0; m < k; m++)
+            if (strcmp(d->subjects[m], s->valuestring) == 0)
+                return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: duplicate subject '%s'", where, key,
+                                s->valuestring);
+        if (!(d->subjects[k] = strdup(s->valuestring)))
+            return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", where);
+        d->n_subjects = k + 1;
+    }
+    return TCB_OK;
+}
+
 static int parse_dataset(const cJSON *o, const char *where, tcb_dataset_spec *d, tcb_error *err)
 {
     const char *name, *root;
@@ -150,8 +183,8 @@ static int parse_dataset(const cJSON *o, const char *where, tcb_dataset_spec *d,
     if (!rc) rc = tcb_json_enum(o, "source", where, 1, 0, tcb_config_source_names, &source, err);
     if (rc) return rc;
     d->source = (tcb_source)source;
-    int synthetic = d->source == TCB_SOURCE_SYNTHETIC;
-    rc = tcb_json_expect_keys(o, where, synthetic ? synthetic_keys : objdir_keys, err);
+    int synthetic = d->source == TCB_SOURCE_SYNTHETIC, dfaust = d->source == TCB_SOURCE_DFAUST;
+    rc = tcb_json_expect_keys(o, where, synthetic ? synthetic_keys : dfaust ? dfaust_keys : objdir_keys, err);
     if (!rc) rc = tcb_json_str(o, "name", where, 1, NULL, &name, err);
     if (!rc) rc = check_name(name, sizeof d->name, where, "name", err);
     if (!rc) rc = tcb_json_int(o, "seed", where, 0, 0, 0, LLONG_MAX, &seed, err);
@@ -160,12 +193,13 @@ static int parse_dataset(const cJSON *o, const char *where, tcb_dataset_spec *d,
     if (!rc) rc = copy_str(d->root, sizeof d->root, root, where, "root", err);
     if (!rc) rc = tcb_json_bool(o, "optional", where, 0, 0, &d->optional, err);
     if (!rc)
-        rc = tcb_json_enum(o, "normalization", where, 0, TCB_NORM_FIRST_FRAME, tcb_config_norm_names, &norm,
-                           err);
+        rc = tcb_json_enum(o, "normalization", where, 0, dfaust ? TCB_NORM_NONE : TCB_NORM_FIRST_FRAME,
+                           tcb_config_norm_names, &norm, err);
     long long align_samples;
     if (!rc) rc = tcb_json_bool(o, "align_rotation", where, 0, 0, &d->align_rotation, err);
     if (!rc) rc = tcb_json_int(o, "align_samples", where, 0, TCB_ALIGN_DEFAULT_SAMPLES, 1, 10000000, &align_samples, err);
-    if (!rc) rc = tcb_json_enum(o, "sampling", where, 0, 0, tcb_config_sampling_names, &sampling, err);
+    if (!rc) rc = tcb_json_enum(o, "sampling", where, 0, dfaust, tcb_config_sampling_names, &sampling, err);
+    if (!rc) rc = parse_subjects(o, where, d, err);
     if (rc) return rc;
     snprintf(d->name, sizeof d->name, "%s", name);
     d->seed = (uint64_t)seed;
@@ -510,7 +544,11 @@ void tcb_config_free(tcb_config *c)
     for (int k = 0; k < c->n_plugins; k++) free(c->plugins[k]);
     free(c->plugins);
     free(c->seeds);
-    for (int k = 0; k < c->n_datasets; k++) free(c->datasets[k].sequences);
+    for (int k = 0; k < c->n_datasets; k++) {
+        for (int s = 0; s < c->datasets[k].n_subjects; s++) free(c->datasets[k].subjects[s]);
+        free(c->datasets[k].subjects);
+        free(c->datasets[k].sequences);
+    }
     free(c->datasets);
     for (int k = 0; k < c->n_methods; k++) {
         free(c->methods[k].params_json);

@@ -315,7 +315,7 @@ static int recompute(const tcb_config *cfg, const tcb_inspect_opts *o, const tar
     char split_path[TCB_PATH_MAX], work[TCB_PATH_MAX], ckpt[TCB_PATH_MAX];
     int rc = *k < 0 ? worst_pair(o->run_dir, t, k, err) : TCB_OK;
     if (!rc) rc = tcb_harness_load_sequence(cfg, t->d, t->s->name, seq, err);
-    if (!rc) rc = tcb_harness_obtain_split(cfg, t->d, t->s, seq->n_frames, split_path,
+    if (!rc) rc = tcb_harness_obtain_split(cfg, t->d, t->s, seq, split_path,
                                            sizeof split_path, &split, err);
     if (!rc) rc = tcb_harness_work_paths(o->run_dir, t->d->name, t->s->name, t->m->label, t->seed,
                                          work, ckpt, err);

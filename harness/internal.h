@@ -103,11 +103,11 @@ int tcb_harness_load_plugins(const tcb_config *cfg, tcb_error *err);
 int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, const char *name,
                               tcb_sequence *seq, tcb_error *err);
 /* <splits_dir>/<dataset>/<sequence>.json into *split (made once, then
- * reused; a file made for other settings is refused, so every method sees
- * the same pairs); its path in path[size]. */
+ * reused; a file made for other settings, frames or blocks than seq's is
+ * refused, so every method sees the same pairs); its path in path[size]. */
 int tcb_harness_obtain_split(const tcb_config *cfg, const tcb_dataset_spec *d,
-                             const tcb_sequence_spec *s, int n_frames, char *path, size_t size,
-                             tcb_split *split, tcb_error *err);
+                             const tcb_sequence_spec *s, const tcb_sequence *seq, char *path,
+                             size_t size, tcb_split *split, tcb_error *err);
 /* A cell's work directory <run>/work/<dataset>/<sequence>/<label>/seed_<s>
  * and its model checkpoint <work>/model.ckpt, both [TCB_PATH_MAX]. */
 int tcb_harness_work_paths(const char *run_dir, const char *dataset, const char *sequence,

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "harness/internal.h"
+#include "tcb/dfaust.h"
 #include "tcb/registry.h"
 #include "tcb/synth.h"
 
@@ -19,8 +20,8 @@
 #define METRICS_S_PER_VERT2 (0.11 / (10002.0 * 10002.0))
 
 typedef struct plan_totals {
-    int cells, done, to_run, unknown;
-    double seconds;  /* of the cells to run with known estimates */
+    int cells, done, to_run, unknown;  /* unknown: cells to run with a part not estimated */
+    double seconds;  /* the estimated parts of the cells to run */
 } plan_totals;
 
 static void duration_text(double s, char *out, size_t size)
@@ -44,8 +45,13 @@ static void probe(const tcb_dataset_spec *d, const char *name, int *n_frames, in
         return;
     }
     char dir[TCB_PATH_MAX];
-    if (tcb_run_root_missing(d) || tcb_path_join(dir, sizeof dir, &err, "%s/%s", d->root, name)) return;
-    if (tcb_sequence_probe_objdir(dir, n_frames, n_verts, &err)) *n_frames = *n_verts = 0;
+    if (tcb_run_root_missing(d)) return;
+    int rc = d->source == TCB_SOURCE_DFAUST
+                 ? tcb_dfaust_probe(d->root, name, d->subjects, d->n_subjects, n_frames, n_verts, &err)
+             : tcb_path_join(dir, sizeof dir, &err, "%s/%s", d->root, name)
+                 ? TCB_ERR_INPUT
+                 : tcb_sequence_probe_objdir(dir, n_frames, n_verts, &err);
+    if (rc) *n_frames = *n_verts = 0;
 }
 
 /* done, failed, diverged, unreadable, missing, or "running (host pid, age)"
@@ -133,9 +139,13 @@ static int plan_cell(void *ctx, const tcb_grid_cell *c)
     fprintf(w->out, "  %4d  %-24s %4d  %-10s %9s %9s  %s\n", c->id, c->method->label, c->seed, state, fit, eval,
             e.basis);
     w->t.cells++;
-    if (!runs) w->t.done++;
-    else if (w->t.to_run++, e.fit_s < 0 || e.eval_s < 0) w->t.unknown++;
-    else w->t.seconds += e.fit_s + e.eval_s;
+    if (!runs) {
+        w->t.done++;
+        return TCB_OK;
+    }
+    w->t.to_run++;
+    w->t.unknown += e.fit_s < 0 || e.eval_s < 0;
+    w->t.seconds += (e.fit_s > 0 ? e.fit_s : 0) + (e.eval_s > 0 ? e.eval_s : 0);
     return TCB_OK;
 }
 
@@ -153,7 +163,8 @@ int tcb_run_dry(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_
     duration_text(t.seconds, total, sizeof total);
     fprintf(out, "cells: %d, %d finished, %d to run: about %s of wall time one after another", t.cells, t.done,
             t.to_run, total);
-    if (t.unknown) fprintf(out, ", plus %d cell%s without an estimate", t.unknown, t.unknown == 1 ? "" : "s");
+    if (t.unknown)
+        fprintf(out, ", plus what is unknown of %d cell%s (\"?\" above)", t.unknown, t.unknown == 1 ? "" : "s");
     fprintf(out, "\n");
     return TCB_OK;
 }

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "harness/internal.h"
+#include "tcb/dfaust.h"
 #include "tcb/fsutil.h"
 #include "tcb/registry.h"
 #include "tcb/synth.h"
@@ -144,6 +145,8 @@ int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, 
     if (d->source == TCB_SOURCE_SYNTHETIC) {
         rc = tcb_synth_generate(name, d->seed, d->frames, seq, err);
         if (!rc) rc = tcb_sequence_prepare(seq, &lo, err);
+    } else if (d->source == TCB_SOURCE_DFAUST) {
+        rc = tcb_sequence_load_dfaust(d->root, name, d->subjects, d->n_subjects, &lo, seq, err);
     } else {
         char dir[TCB_PATH_MAX];
         rc = tcb_path_join(dir, sizeof dir, err, "%s/%s", d->root, name);
@@ -162,13 +165,13 @@ int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, 
 }
 
 int tcb_harness_obtain_split(const tcb_config *cfg, const tcb_dataset_spec *d,
-                             const tcb_sequence_spec *s, int n_frames, char *path, size_t size,
-                             tcb_split *split, tcb_error *err)
+                             const tcb_sequence_spec *s, const tcb_sequence *seq, char *path,
+                             size_t size, tcb_split *split, tcb_error *err)
 {
     int rc = tcb_path_join(path, size, err, "%s/%s/%s.json", cfg->splits_dir, d->name, s->name);
     if (rc) return rc;
-    return tcb_split_obtain(path, d->name, s->name, s->role, n_frames, cfg->eval_pairs,
-                            cfg->split_seed, split, err);
+    return tcb_split_obtain(path, d->name, s->name, s->role, seq->n_frames, seq->blocks, seq->n_blocks,
+                            cfg->eval_pairs, cfg->split_seed, split, err);
 }
 
 int tcb_harness_work_paths(const char *run_dir, const char *dataset, const char *sequence,
@@ -350,8 +353,7 @@ static int run_sequence(const run_state *st, const tcb_dataset_spec *d, const tc
     int rc = tcb_harness_load_sequence(st->cfg, d, s->name, &seq, err);
     if (rc) return rc;
     seq_ctx sc = {d, &seq, &split, split_path, tcb_now_seconds() - t0};
-    rc = tcb_harness_obtain_split(st->cfg, d, s, seq.n_frames, split_path, sizeof split_path,
-                                  &split, err);
+    rc = tcb_harness_obtain_split(st->cfg, d, s, &seq, split_path, sizeof split_path, &split, err);
     if (!rc) rc = run_cells(st, &sc, first, err);
     tcb_split_free(&split);
     tcb_sequence_free(&seq);
@@ -360,7 +362,7 @@ static int run_sequence(const run_state *st, const tcb_dataset_spec *d, const tc
 
 int tcb_run_root_missing(const tcb_dataset_spec *d)
 {
-    return d->source == TCB_SOURCE_OBJDIR && !tcb_is_dir(d->root);
+    return d->source != TCB_SOURCE_SYNTHETIC && !tcb_is_dir(d->root);
 }
 
 void tcb_run_missing_root_text(const tcb_dataset_spec *d, char *out, size_t size)

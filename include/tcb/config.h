@@ -25,7 +25,15 @@
  *         "root": "../shared/data/anim", objdir sources only: <root>/<sequence>/; may be
  *                                        left out and given as --root NAME=DIR or in the
  *                                        environment as TCBENCH_ROOT_<NAME>
- *         "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
+ *         "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] },
+ *       { "name": "dfaust", "source": "dfaust", tcb/dfaust.h: one block of frames per subject
+ *         "root": "../shared/data/dfaust", holds registrations_m.hdf5 and/or _f.hdf5
+ *         "subjects": ["50002", "50004"],  default: every subject that has the sequence
+ *         "normalization": "none",         this source's default, as
+ *         "sampling": "with_replacement",  this one's (reference-protocol §1.2, §1.3)
+ *         "optional": false,               as objdir; no "align_rotation" (it would chain
+ *                                          frames across subjects)
+ *         "sequences": [ { "name": "jumping_jacks", "role": "validation" } ] } ],
  *     "methods": [ { "name": "oracle" },
  *                  { "name": "mca-cpu", "method": "mca", "params": { … },
  *                    "seeds": [0, 1, 2],          its own seeds instead of the config's
@@ -46,7 +54,7 @@
 extern "C" {
 #endif
 
-typedef enum tcb_source { TCB_SOURCE_SYNTHETIC, TCB_SOURCE_OBJDIR } tcb_source;
+typedef enum tcb_source { TCB_SOURCE_SYNTHETIC, TCB_SOURCE_OBJDIR, TCB_SOURCE_DFAUST } tcb_source;
 
 typedef struct tcb_sequence_spec {
     char name[TCB_NAME_MAX];
@@ -64,6 +72,8 @@ typedef struct tcb_dataset_spec {
     int align_samples;       /* its vertex subset; 0 without align_rotation */
     int with_replacement;
     int optional;
+    int n_subjects;          /* dfaust: the listed subjects; 0 = every one found */
+    char **subjects;
     int n_sequences;
     tcb_sequence_spec *sequences;
 } tcb_dataset_spec;

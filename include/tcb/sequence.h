@@ -1,7 +1,9 @@
 /* tcbench — a deforming-shape sequence: K frames of one mesh topology.
  *
  * Vertex k is the same surface point in every frame, so vertex ids are the
- * ground-truth correspondences. After loading, a sequence is normalized
+ * ground-truth correspondences. A sequence may consist of several blocks of
+ * consecutive frames (DFAUST: one per subject, tcb/block.h); pairs stay
+ * inside a block. After loading, a sequence is normalized
  * (reference-protocol §1.3) and carries per frame a pool of area-uniform
  * surface samples from which methods draw their input clouds (§1.2).
  *
@@ -14,6 +16,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "tcb/block.h"
 #include "tcb/error.h"
 #include "tcb/rng.h"
 
@@ -51,11 +54,19 @@ typedef struct tcb_sequence {
      * with or without replacement (see tcb_sequence_draw_points). */
     int input_points;
     int draw_with_replacement;
+    int n_blocks;       /* 0: one block, the whole sequence (every source but DFAUST) */
+    tcb_block *blocks;  /* [n_blocks], tiling [0, n_frames) in order */
 } tcb_sequence;
 
 static inline const float *tcb_seq_frame(const tcb_sequence *s, int f)
 {
     return s->verts + (size_t)f * (size_t)s->n_verts * 3;
+}
+
+/* The block of frame f: its index and frames [*lo, *hi) (tcb_block_find). */
+static inline int tcb_seq_block_of(const tcb_sequence *s, int f, int *lo, int *hi)
+{
+    return tcb_block_find(s->blocks, s->n_blocks, s->n_frames, f, lo, hi);
 }
 
 static inline const float *tcb_seq_pool(const tcb_sequence *s, int f)

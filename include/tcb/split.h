@@ -2,12 +2,16 @@
  *
  * A split file is written once per sequence and then reused, so every method
  * is scored on the identical 500 pairs (i, j), i ≠ j (reference-protocol
- * §5.2; the authors drew fresh unseeded pairs per run, we fix them). */
+ * §5.2; the authors drew fresh unseeded pairs per run, we fix them). For a
+ * sequence of several blocks (DFAUST subjects, tcb/block.h) i is uniform
+ * over all frames and j over the other frames of i's block, and the split
+ * records the blocks. */
 #ifndef TCB_SPLIT_H
 #define TCB_SPLIT_H
 
 #include <stdint.h>
 
+#include "tcb/block.h"
 #include "tcb/error.h"
 #include "tcb/rng.h"
 
@@ -27,33 +31,43 @@ typedef struct tcb_split {
     char sequence[128];
     tcb_role role;
     int n_frames;
+    int n_blocks;      /* 0: one block, all frames (the file has no "blocks") */
+    tcb_block *blocks; /* [n_blocks] */
     uint64_t seed;
     int n_pairs;
-    int32_t *pairs; /* [n_pairs][2]: i uniform over frames, j uniform over the others */
+    int32_t *pairs; /* [n_pairs][2]: i uniform over frames, j uniform over the others of i's block */
 } tcb_split;
 
+/* blocks[0..n_blocks) as the sequence's (tcb_blocks_check); NULL, 0 for
+ * one block. */
 int tcb_split_make(const char *dataset, const char *sequence, tcb_role role, int n_frames,
-                   int n_pairs, uint64_t seed, tcb_split *out, tcb_error *err);
+                   const tcb_block *blocks, int n_blocks, int n_pairs, uint64_t seed,
+                   tcb_split *out, tcb_error *err);
 int tcb_split_save(const char *path, const tcb_split *s, tcb_error *err); /* JSON, atomic */
 int tcb_split_load(const char *path, tcb_split *out, tcb_error *err);
 /* Load `path` if it exists and agrees with the request (dataset, sequence,
- * role, n_frames, n_pairs, seed), else make and save it. Disagreement is an
- * error (TCB_ERR_INPUT) naming the file and the first differing field; the
- * pairs of an existing file are used as stored. */
+ * role, n_frames, blocks, n_pairs, seed), else make and save it.
+ * Disagreement is an error (TCB_ERR_INPUT) naming the file and the first
+ * differing field; the pairs of an existing file are used as stored. */
 int tcb_split_obtain(const char *path, const char *dataset, const char *sequence,
-                     tcb_role role, int n_frames, int n_pairs, uint64_t seed,
-                     tcb_split *out, tcb_error *err);
+                     tcb_role role, int n_frames, const tcb_block *blocks, int n_blocks,
+                     int n_pairs, uint64_t seed, tcb_split *out, tcb_error *err);
 void tcb_split_free(tcb_split *s);
 
-/* Training-pair sampling (§1.4): given i, draw j ≠ i.
- *   NEIGHBORS:  1 ≤ |i − j| ≤ delta, clipped to [0, n_frames)
- *   RANDOM, WITHIN_SEQ: uniform over the other frames (one sequence)
- * Returns −1 when no j exists (n_frames < 2, i outside [0, n_frames), or
- * delta < 1 for NEIGHBORS): the caller reports it. */
+/* Training-pair sampling (§1.4): given i in its block [lo, hi) of a
+ * sequence of n_frames frames (tcb_seq_block_of; [0, n_frames) without
+ * blocks), draw j ≠ i.
+ *   NEIGHBORS:  1 ≤ |i − j| ≤ delta, clipped to the block [lo, hi)
+ *   RANDOM:     uniform over the other frames of the whole sequence, across
+ *               blocks (subjects), as the authors' code does
+ *   WITHIN_SEQ: uniform over the other frames of the block
+ * Returns −1 when no j exists (a block of fewer than 2 frames, [lo, hi) not
+ * inside [0, n_frames), i outside [lo, hi), or delta < 1 for NEIGHBORS):
+ * the caller reports it. */
 typedef enum tcb_pair_mode { TCB_PAIRS_NEIGHBORS, TCB_PAIRS_RANDOM, TCB_PAIRS_WITHIN_SEQ } tcb_pair_mode;
 
 int tcb_pair_mode_parse(const char *name, tcb_pair_mode *out); /* 0 ok, -1 unknown */
-int tcb_pair_sample(tcb_pair_mode mode, int delta, int n_frames, int i, tcb_rng *rng);
+int tcb_pair_sample(tcb_pair_mode mode, int delta, int n_frames, int lo, int hi, int i, tcb_rng *rng);
 
 #ifdef __cplusplus
 }

@@ -63,8 +63,10 @@ void tcb_atlas_trainer_free(tcb_atlas_trainer *t)
 static int draw_batch(tcb_atlas_trainer *t, const tcb_sequence *seq, tcb_error *err)
 {
     for (int p = 0; p < TCB_ATLAS_BATCH / 2; p++) {
-        int a = (int)tcb_rng_below(&t->rng, (uint32_t)seq->n_frames);
-        int b = tcb_pair_sample(t->cfg.pairs, t->cfg.delta, seq->n_frames, a, &t->rng);
+        int lo, hi, a = (int)tcb_rng_below(&t->rng, (uint32_t)seq->n_frames);
+        /* neighbors: a's block (subject) only; random: the whole sequence (§1.4) */
+        tcb_seq_block_of(seq, a, &lo, &hi);
+        int b = tcb_pair_sample(t->cfg.pairs, t->cfg.delta, seq->n_frames, lo, hi, a, &t->rng);
         if (b < 0) return tcb_fail(err, TCB_ERR_INTERNAL, "atlas: no partner frame for frame %d", a);
         t->frames[2 * p] = a, t->frames[2 * p + 1] = b;
     }

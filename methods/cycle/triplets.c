@@ -4,6 +4,7 @@
  * (ThibaultGROUEIX/CycleConsistentDeformation). */
 #include "methods/cycle/triplets.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -54,12 +55,13 @@ static int nn_sum(const tcb_nn *nn, const float *queries, int m, int32_t *idx, f
     return TCB_OK;
 }
 
-/* D[a][b] and D[b][a] for all b > a; row a's pairs in one thread. */
+/* D[a][b] and D[b][a] for all b > a in a's block [.., hi); row a's pairs in
+ * one thread. */
 static int distance_row(tcb_nn *const *nn, const float *sub, size_t frame_len, int m, int n,
-                        int a, int32_t *idx, float *d2, double *D, tcb_error *err)
+                        int a, int hi, int32_t *idx, float *d2, double *D, tcb_error *err)
 {
     D[(size_t)a * n + a] = 0.0;
-    for (int b = a + 1; b < n; b++) {
+    for (int b = a + 1; b < hi; b++) {
         double ab, ba;
         int rc = nn_sum(nn[b], sub + (size_t)a * frame_len, m, idx, d2, &ab, err);
         if (!rc) rc = nn_sum(nn[a], sub + (size_t)b * frame_len, m, idx, d2, &ba, err);
@@ -108,6 +110,7 @@ int tcb_cc_frame_distances(const tcb_sequence *seq, int points, int in_box, doub
         if (rc) tcb_error_prefix(err, "cc: sequence %s, frame %d: ", seq->name, f);
     }
     if (rc) goto done;
+    for (size_t e = 0; e < (size_t)n * n; e++) D[e] = INFINITY; /* between blocks: not measured */
 
     /* Rows in parallel (each D entry is written by one thread, in a fixed
      * order, so D does not depend on the thread count); tcb_nn's own
@@ -127,8 +130,9 @@ int tcb_cc_frame_distances(const tcb_sequence *seq, int points, int in_box, doub
         tcb_error e = {0};
 #pragma omp for schedule(dynamic, 1)
         for (int a = 0; a < n - 1; a++) {
-            int b = -2;
-            if (idx && d2) b = distance_row(nn, sub, frame_len, m, n, a, idx, d2, D, &e);
+            int b = -2, lo, hi;
+            tcb_seq_block_of(seq, a, &lo, &hi);
+            if (idx && d2) b = distance_row(nn, sub, frame_len, m, n, a, hi, idx, d2, D, &e);
             else tcb_fail(&e, TCB_ERR_NOMEM, "cannot allocate query buffers");
             if (b != -1) {
 #pragma omp critical(tcb_cc_distances)
@@ -168,8 +172,17 @@ static int cmp_ranked(const void *pa, const void *pb)
     return (a->f > b->f) - (a->f < b->f);
 }
 
+/* Row a's length: k clipped to a's block (the whole sequence without blocks). */
+static int knn_row_len(const tcb_cc_sampler *s, int a)
+{
+    int lo, hi;
+    tcb_block_find(s->blocks, s->n_blocks, s->n_frames, a, &lo, &hi);
+    return s->k < hi - lo ? s->k : hi - lo;
+}
+
 /* Row a: a first (kneighbors on the training set returns the query shape
- * itself at distance 0), then the other frames by (distance, index). */
+ * itself at distance 0), then the other frames of a's block by (distance,
+ * index). */
 static int build_knn(tcb_cc_sampler *s, const tcb_sequence *seq, const tcb_cc_sampler_opts *o,
                      tcb_error *err)
 {
@@ -184,18 +197,33 @@ static int build_knn(tcb_cc_sampler *s, const tcb_sequence *seq, const tcb_cc_sa
                       seq->name);
     if (!rc) rc = tcb_cc_frame_distances(seq, o->knn_points, o->knn_in_box, D, err);
     for (int a = 0; a < n && !rc; a++) {
-        int len = 0;
-        for (int f = 0; f < n; f++)
+        int len = 0, lo, hi, ka = knn_row_len(s, a);
+        tcb_seq_block_of(seq, a, &lo, &hi);
+        for (int f = lo; f < hi; f++)
             if (f != a) row[len].d = D[(size_t)a * n + f], row[len++].f = f;
         qsort(row, (size_t)len, sizeof *row, cmp_ranked);
         int32_t *out = s->knn + (size_t)a * k;
         double *dist = s->knn_dist + (size_t)a * k;
         out[0] = a, dist[0] = 0.0;
-        for (int j = 1; j < k; j++) out[j] = row[j - 1].f, dist[j] = row[j - 1].d;
+        for (int j = 1; j < k; j++) {
+            out[j] = j < ka ? row[j - 1].f : -1;
+            dist[j] = j < ka ? row[j - 1].d : INFINITY;
+        }
     }
     free(D);
     free(row);
     return rc;
+}
+
+/* The sampler keeps no pointer into the sequence: its own copy of the blocks. */
+static int copy_blocks(tcb_cc_sampler *s, const tcb_sequence *seq, tcb_error *err)
+{
+    if (seq->n_blocks == 0) return TCB_OK;
+    s->blocks = malloc((size_t)seq->n_blocks * sizeof *s->blocks);
+    if (!s->blocks) return tcb_fail(err, TCB_ERR_NOMEM, "cc: cannot allocate a sampler");
+    memcpy(s->blocks, seq->blocks, (size_t)seq->n_blocks * sizeof *s->blocks);
+    s->n_blocks = seq->n_blocks;
+    return TCB_OK;
 }
 
 int tcb_cc_sampler_create(const tcb_sequence *seq, const tcb_cc_sampler_opts *opts,
@@ -223,14 +251,22 @@ int tcb_cc_sampler_create(const tcb_sequence *seq, const tcb_cc_sampler_opts *op
     s->sampling = o.sampling;
     s->n_frames = seq->n_frames;
     s->delta = o.delta;
-    if (o.sampling == TCB_CC_SAMPLE_KNN) {
-        /* self.num_neighbors = min(self.num_neighbors, len(self.datas)) */
-        s->k = o.knn_k < s->n_frames ? o.knn_k : s->n_frames;
-        int rc = build_knn(s, seq, &o, err);
-        if (rc) {
-            tcb_cc_sampler_free(s);
-            return rc;
+    int rc = copy_blocks(s, seq, err);
+    if (!rc && o.sampling == TCB_CC_SAMPLE_KNN) {
+        /* self.num_neighbors = min(self.num_neighbors, len(self.datas)),
+         * the datas being those of one block */
+        int longest = 0;
+        for (int a = 0; a < s->n_frames; a++) {
+            int lo, hi;
+            tcb_seq_block_of(seq, a, &lo, &hi);
+            if (hi - lo > longest) longest = hi - lo;
         }
+        s->k = o.knn_k < longest ? o.knn_k : longest;
+        rc = build_knn(s, seq, &o, err);
+    }
+    if (rc) {
+        tcb_cc_sampler_free(s);
+        return rc;
     }
     *out = s;
     return TCB_OK;
@@ -241,26 +277,26 @@ void tcb_cc_sampler_free(tcb_cc_sampler *s)
     if (!s) return;
     free(s->knn);
     free(s->knn_dist);
+    free(s->blocks);
     free(s);
 }
 
 void tcb_cc_sampler_draw(const tcb_cc_sampler *s, tcb_rng *rng, int out[3])
 {
     const int n = s->n_frames;
-    /* Future DFAUST sequences hold several subject blocks: restricting a
-     * triplet to A's block would go here (B, C drawn within [lo, hi) of A's
-     * block; for knn, the graph built per block). Not implemented. */
     const int a = (int)tcb_rng_below(rng, (uint32_t)n);
+    int lo, hi;
+    tcb_block_find(s->blocks, s->n_blocks, n, a, &lo, &hi);
     out[0] = a;
     for (int t = 1; t < 3; t++) {
         switch (s->sampling) {
         case TCB_CC_SAMPLE_RANDOM: out[t] = (int)tcb_rng_below(rng, (uint32_t)n); break;
         case TCB_CC_SAMPLE_KNN:
-            out[t] = s->knn[(size_t)a * s->k + tcb_rng_below(rng, (uint32_t)s->k)];
+            out[t] = s->knn[(size_t)a * s->k + tcb_rng_below(rng, (uint32_t)knn_row_len(s, a))];
             break;
         case TCB_CC_SAMPLE_NEIGHBORS:
-            /* delta ≥ 1 and n ≥ 2 were checked at creation: never −1. */
-            out[t] = tcb_pair_sample(TCB_PAIRS_NEIGHBORS, s->delta, n, a, rng);
+            /* delta ≥ 1 and blocks of ≥ 2 frames were checked: never −1. */
+            out[t] = tcb_pair_sample(TCB_PAIRS_NEIGHBORS, s->delta, n, lo, hi, a, rng);
             break;
         }
     }

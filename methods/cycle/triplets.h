@@ -5,18 +5,20 @@
  * triplets. Three ways to pick them:
  *
  *   random     A, B, C independently uniform over all frames (B and C may
- *              equal A or each other): ShapeNetSeg.__getitem__ with knn=False,
+ *              equal A or each other; across blocks, as the atlas methods'
+ *              random pairs): ShapeNetSeg.__getitem__ with knn=False,
  *              index_2 = np.random.randint(len), index_3 likewise.
  *   knn        A uniform; B and C independently uniform (with replacement)
- *              over the k = min(20, n_frames) nearest frames of A, A itself
- *              included and first: ShapeNetSeg.__getitem__ with knn=True,
+ *              over the k = min(20, n) nearest frames of A among the n frames
+ *              of A's block (tcb/block.h; the whole sequence without blocks),
+ *              A itself included and first: ShapeNetSeg.__getitem__ with knn=True,
  *              self.indices[index][np.random.randint(num_neighbors)], where
  *              compute_nearest_neighbors_graph fits sklearn NearestNeighbors
  *              (metric = useful_losses.NN_metric) on the training shapes and
  *              calls kneighbors on the same shapes (so each shape is its own
  *              first neighbour).
  *   neighbors  A uniform; B and C independently uniform over the time window
- *              {f ≠ A : |f − A| ≤ delta} ∩ [0, n_frames) — the atlas methods'
+ *              {f ≠ A : |f − A| ≤ delta} ∩ A's block — the atlas methods'
  *              neighbour pairs (tcb_pair_sample, TCB_PAIRS_NEIGHBORS). Not in
  *              the CC code; tcbench's temporal variant.
  *
@@ -29,10 +31,10 @@
  * default) the subsets are first mapped into their frames' CC boxes
  * (augment.h), as the CC code computes the graph on BoundingBox-normalized
  * shapes; without it the sequence's own coordinates are used. The graph is
- * built once at creation: n(n−1)/2 distances, 2 NN passes of m queries over
- * m points each (35 frames × 2500 points: 595 pairs). Rows are ordered A
- * first (distance 0), then by (distance, frame index) — ties go to the lower
- * index.
+ * built once at creation: n(n−1)/2 distances per block of n frames, 2 NN
+ * passes of m queries over m points each (35 frames × 2500 points: 595
+ * pairs). Rows are ordered A first (distance 0), then by (distance, frame
+ * index) — ties go to the lower index.
  *
  * Randomness comes only from the caller's tcb_rng (the trainer's stream);
  * one draw uses it in the fixed order A, then B, then C. */
@@ -75,9 +77,12 @@ tcb_cc_sampler_opts tcb_cc_sampler_opts_default(void);
 typedef struct tcb_cc_sampler {
     tcb_cc_sampling sampling;
     int n_frames;
+    int n_blocks;       /* a copy of the sequence's blocks (0: one block) */
+    tcb_block *blocks;
     int delta;          /* NEIGHBORS */
-    int k;              /* KNN: min(knn_k, n_frames); 0 otherwise */
-    int32_t *knn;       /* KNN: [n_frames][k] frame ids; row a starts with a */
+    int k;              /* KNN: min(knn_k, frames of the longest block); 0 otherwise */
+    int32_t *knn;       /* KNN: [n_frames][k] frame ids; row a starts with a and holds
+                         * min(k, frames of a's block) of them, then −1 */
     double *knn_dist;   /* KNN: [n_frames][k] D(a, knn[a][j]); knn_dist[a][0] = 0 */
 } tcb_cc_sampler;
 
@@ -93,13 +98,14 @@ int tcb_cc_sampler_create(const tcb_sequence *seq, const tcb_cc_sampler_opts *op
 void tcb_cc_sampler_free(tcb_cc_sampler *s);
 
 /* out = {A, B, C}. Draws: A = below(n_frames), then B, then C (random:
- * below(n_frames) each; knn: a row position below(k) each; neighbors:
- * tcb_pair_sample each). */
+ * below(n_frames) each; knn: a row position below(k of A's row) each;
+ * neighbors: tcb_pair_sample each). */
 void tcb_cc_sampler_draw(const tcb_cc_sampler *s, tcb_rng *rng, int out[3]);
 
-/* The full symmetric distance matrix D [n_frames][n_frames] (D[a][a] = 0) on
+/* The symmetric distance matrix D [n_frames][n_frames] (D[a][a] = 0) on
  * the first min(pool_size, points) pool points of each frame, in the CC
- * boxes when in_box; what the knn sampler sorts. Errors as create. */
+ * boxes when in_box; what the knn sampler sorts. Only pairs of frames in one
+ * block are measured; D between blocks is +inf. Errors as create. */
 int tcb_cc_frame_distances(const tcb_sequence *seq, int points, int in_box, double *D,
                            tcb_error *err);
 

@@ -7,7 +7,7 @@
  *     int32    version       1
  *     int32    strategy, rounds, smooth, smooth_last, k
  *     int32    n_frames, n_verts
- *     uint64   FNV-1a hash of the sequence's vertex coordinates
+ *     uint64   FNV-1a hash of the sequence's vertex coordinates (and block starts)
  *     int32    maps[2][n_frames − 1][n_verts]   (propagate_simple/bijective only)
  * Load refuses a file written for another strategy, other parameters or
  * another sequence, any map entry outside the frame and, for
@@ -23,12 +23,20 @@
 #define N_FIELDS 8 /* the int32 fields after the magic */
 #define HEADER_BYTES (8 + N_FIELDS * 4 + 8)
 
+static uint64_t fnv1a(uint64_t h, const void *data, size_t len)
+{
+    const unsigned char *b = data;
+    for (size_t k = 0; k < len; k++) h = (h ^ b[k]) * 1099511628211ull;
+    return h;
+}
+
+/* The blocks decide which maps are registered (maps.c): they are hashed
+ * too, after the vertices, so a sequence without blocks keeps its hash. */
 uint64_t nricp_sequence_hash(const tcb_sequence *seq)
 {
-    const unsigned char *b = (const unsigned char *)seq->verts;
     size_t len = (size_t)seq->n_frames * seq->n_verts * 3 * sizeof(float);
-    uint64_t h = 1469598103934665603ull;
-    for (size_t k = 0; k < len; k++) h = (h ^ b[k]) * 1099511628211ull;
+    uint64_t h = fnv1a(1469598103934665603ull, seq->verts, len);
+    for (int k = 0; k < seq->n_blocks; k++) h = fnv1a(h, &seq->blocks[k].start, sizeof seq->blocks[k].start);
     return h;
 }
 

@@ -4,7 +4,11 @@
  * P_{k+1}, by nearest neighbour (simple) or by an exact linear assignment on
  * squared distances (bijective). The reverse maps (k+1 → k, registering
  * P_{k+1} onto P_k) are computed as well, so pairs with j < i run the chain
- * backwards. */
+ * backwards. A chain never leaves its block (DFAUST: its subject; pairs are
+ * drawn inside blocks and nricp_transfer refuses others), so the maps
+ * between the last frame of a block and the first of the next are not
+ * registered: they stay the identity, which keeps the layout and the
+ * checkpoint's checks (a permutation) as they are. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -29,11 +33,17 @@ static double *sq_dist_matrix(const float *moved, const float *target, int n)
     return cost;
 }
 
-/* map = c_{a→b}: register frame a onto frame b, then match. */
+/* map = c_{a→b}: register frame a onto frame b, then match; the identity
+ * across a block boundary (no chain uses it). */
 static int one_map(const nricp_method *m, const tcb_sequence *seq, int a, int b, int32_t *map,
                    tcb_error *err)
 {
-    int nv = m->n_verts;
+    int nv = m->n_verts, lo, hi;
+    tcb_seq_block_of(seq, a, &lo, &hi);
+    if (b < lo || b >= hi) {
+        for (int v = 0; v < nv; v++) map[v] = v;
+        return TCB_OK;
+    }
     const float *pa = tcb_seq_frame(seq, a), *pb = tcb_seq_frame(seq, b);
     const float *na = m->normals + (size_t)a * nv * 3, *nb = m->normals + (size_t)b * nv * 3;
     float *moved = malloc((size_t)nv * 3 * sizeof *moved);

@@ -128,6 +128,12 @@ static int nricp_transfer(void *self, const tcb_sequence *seq, int i, int j, con
         return tcb_fail(err, TCB_ERR_INTERNAL, "nricp: transfer before fit on sequence %s", seq->name);
     if (i < 0 || j < 0 || i >= m->n_frames || j >= m->n_frames)
         return tcb_fail(err, TCB_ERR_INPUT, "nricp: pair %d->%d outside frames 0..%d", i, j, m->n_frames - 1);
+    int lo, hi;
+    tcb_seq_block_of(seq, i, &lo, &hi);
+    /* The propagating chains run through consecutive frames of one block. */
+    if (m->strategy != NRICP_RANDOM && (j < lo || j >= hi))
+        return tcb_fail(err, TCB_ERR_INPUT, "nricp: %s: pair %d->%d crosses the block boundary of [%d, %d)",
+                        nricp_strategy_names[m->strategy], i, j, lo, hi);
     /* Normals and vertex maps exist only for whole frames of GT vertices. */
     if (n != m->n_verts)
         return tcb_fail(err, TCB_ERR_INPUT,

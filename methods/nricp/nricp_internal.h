@@ -57,7 +57,7 @@ int nricp_fit_maps(nricp_method *m, const tcb_sequence *seq, const tcb_fit_ctx *
 void nricp_compose(const nricp_method *m, int i, int j, int32_t *idx);
 
 /* checkpoint.c */
-uint64_t nricp_sequence_hash(const tcb_sequence *seq); /* FNV-1a of the vertex coordinates */
+uint64_t nricp_sequence_hash(const tcb_sequence *seq); /* FNV-1a of the vertices and block starts */
 int nricp_save(void *self, const char *path, tcb_error *err);
 int nricp_load(void *self, const tcb_sequence *seq, const char *path, tcb_error *err);
 

@@ -53,6 +53,8 @@ static void assert_same_sequence(const tcb_sequence *a, const tcb_sequence *b)
     assert_memory_equal(a->pools, b->pools, sizeof(float) * 3 * F * (size_t)a->pool_size);
     assert_int_equal(a->yaw != NULL, b->yaw != NULL);
     if (a->yaw) assert_memory_equal(a->yaw, b->yaw, sizeof(double) * F);
+    assert_int_equal(a->n_blocks, b->n_blocks);
+    if (a->n_blocks) assert_memory_equal(a->blocks, b->blocks, sizeof *a->blocks * (size_t)a->n_blocks);
 }
 
 static void load_fresh(const char *dir, tcb_sequence *s)
@@ -64,6 +66,15 @@ static void load_fresh(const char *dir, tcb_sequence *s)
     assert_int_equal(tcb_sequence_load_objdir(frames, "pyramid", &o, s, &err), TCB_OK);
 }
 
+/* s saved to path under key, loaded back into *back and compared. */
+static void save_and_reload(const char *path, const tcb_sequence *s, const char *key, tcb_sequence *back)
+{
+    tcb_error err = {0};
+    assert_int_equal(tcb_sequence_cache_save(path, s, key, &err), TCB_OK);
+    assert_int_equal(tcb_sequence_cache_load(path, key, back, &err), TCB_OK);
+    assert_same_sequence(s, back);
+}
+
 static void test_round_trip_bit_exact(void **state)
 {
     const char *dir = *state;
@@ -73,9 +84,7 @@ static void test_round_trip_bit_exact(void **state)
     char path[TCB_PATH_MAX];
     snprintf(path, sizeof path, "%s/cache/pyramid.h5", dir);
     tcb_error err = {0};
-    assert_int_equal(tcb_sequence_cache_save(path, &s, "key-1", &err), TCB_OK);
-    assert_int_equal(tcb_sequence_cache_load(path, "key-1", &back, &err), TCB_OK);
-    assert_same_sequence(&s, &back);
+    save_and_reload(path, &s, "key-1", &back);
     tcb_sequence_free(&back);
     /* A different key is stale, not corrupt: the caller re-parses. */
     assert_int_equal(tcb_sequence_cache_load(path, "key-2", &back, &err), TCB_ERR_UNSUPPORTED);
@@ -107,6 +116,53 @@ static void test_long_key(void **state)
     assert_int_equal(tcb_sequence_cache_load(path, key, &back, &err), TCB_ERR_UNSUPPORTED);
     free(key);
     tcb_sequence_free(&s);
+}
+
+/* The blocks (DFAUST subjects) are stored and restored; blocks that do not
+ * tile the frames make the file corrupt. */
+static void test_blocks_round_trip(void **state)
+{
+    const char *dir = *state;
+    write_frames(dir, 5);
+    tcb_sequence s, back;
+    load_fresh(dir, &s);
+    s.blocks = calloc(2, sizeof *s.blocks);
+    s.n_blocks = 2;
+    s.blocks[0] = (tcb_block){"50002", 0, 2};
+    s.blocks[1] = (tcb_block){"50004", 2, 3};
+    char path[TCB_PATH_MAX];
+    snprintf(path, sizeof path, "%s/blocks.h5", dir);
+    save_and_reload(path, &s, "k", &back);
+    tcb_sequence_free(&back);
+    tcb_error err = {0};
+    s.blocks[1].n_frames = 2; /* frame 4 in no block */
+    assert_int_equal(tcb_sequence_cache_save(path, &s, "k", &err), TCB_OK);
+    assert_int_equal(tcb_sequence_cache_load(path, "k", &back, &err), TCB_ERR_INPUT);
+    assert_non_null(strstr(err.msg, "bad blocks"));
+    assert_null(back.blocks);
+    tcb_sequence_free(&s);
+}
+
+/* A cache written by the previous format (3, before blocks) is stale: the
+ * caller parses afresh. */
+static void test_old_format_is_stale(void **state)
+{
+    const char *dir = *state;
+    write_frames(dir, 3);
+    tcb_sequence s;
+    load_fresh(dir, &s);
+    char path[TCB_PATH_MAX];
+    snprintf(path, sizeof path, "%s/old.h5", dir);
+    tcb_error err = {0};
+    assert_int_equal(tcb_sequence_cache_save(path, &s, "k", &err), TCB_OK);
+    tcb_sequence_free(&s);
+    hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+    hid_t a = H5Aopen(f, "format_version", H5P_DEFAULT);
+    const int old = 3;
+    assert_true(f >= 0 && a >= 0 && H5Awrite(a, H5T_NATIVE_INT, &old) >= 0);
+    H5Aclose(a), H5Fclose(f);
+    assert_int_equal(tcb_sequence_cache_load(path, "k", &s, &err), TCB_ERR_UNSUPPORTED);
+    assert_non_null(strstr(err.msg, "stale cache (format 3"));
 }
 
 static void expect_corrupt(const char *path)
@@ -281,6 +337,8 @@ int main(void)
 #define T(f) cmocka_unit_test_setup_teardown(f, tu_setup_tmpdir, tu_teardown_tmpdir)
     const struct CMUnitTest tests[] = {
         T(test_round_trip_bit_exact),
+        T(test_blocks_round_trip),
+        T(test_old_format_is_stale),
         T(test_aligned_load_caches_yaw),
         T(test_long_key),
         T(test_corrupt_and_foreign_files),

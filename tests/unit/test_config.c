@@ -181,6 +181,11 @@ typedef struct bad_case {
 #define SEQ(name, role) "{\"name\": \"" name "\", \"role\": \"" role "\"}"
 #define SYNTH(extra, seqs) \
     "{\"name\": \"synth\", \"source\": \"synthetic\", " extra "\"sequences\": [" seqs "]}"
+#define OBJDIR(extra) \
+    "{\"name\": \"a\", \"source\": \"objdir\", \"root\": \"r\", " extra "\"sequences\": [" SEQ("cat", "test") "]}"
+#define DFAUST(extra, seqs) \
+    "{\"name\": \"dfaust\", \"source\": \"dfaust\", " extra "\"sequences\": [" seqs "]}"
+#define DFAUST_SUBJECTS(list) DFAUST("\"root\": \"d\", \"subjects\": " list ", ", SEQ("hips", "test"))
 
 static const bad_case bad_cases[] = {
     /* types */
@@ -214,10 +219,7 @@ static const bad_case bad_cases[] = {
     {NULL, NULL, "{\"name\": \"nearest\", \"param\": {}}", "t.json: methods[0].param: unknown key"},
     {NULL, SYNTH("\"root\": \"x\", ", SEQ("quadruped_walk", "test")), NULL,
      "t.json: datasets[0].root: unknown key"},
-    {NULL,
-     "{\"name\": \"a\", \"source\": \"objdir\", \"root\": \"r\", \"frames\": 3, \"sequences\": "
-     "[" SEQ("cat", "test") "]}",
-     NULL, "t.json: datasets[0].frames: unknown key"},
+    {NULL, OBJDIR("\"frames\": 3, "), NULL, "t.json: datasets[0].frames: unknown key"},
     /* values */
     {NULL, SYNTH("", SEQ("quadruped_walk", "test") ", " SEQ("quadruped_trot", "tset")), NULL,
      "t.json: datasets[0].sequences[1].role: unknown role 'tset' (expected train, validation or "
@@ -243,6 +245,17 @@ static const bad_case bad_cases[] = {
     {NULL, NULL, "", "t.json: methods: must list at least one method"},
     {NULL, "", NULL, "t.json: datasets: must list at least one dataset"},
     {NULL, SYNTH("", ""), NULL, "t.json: datasets[0].sequences: must list at least one sequence"},
+    /* dfaust */
+    {NULL, DFAUST_SUBJECTS("\"50002\""), NULL, "t.json: datasets[0].subjects: expected an array"},
+    {NULL, DFAUST_SUBJECTS("[]"), NULL, "t.json: datasets[0].subjects: must list at least one subject"},
+    {NULL, DFAUST_SUBJECTS("[50002]"), NULL, "datasets[0].subjects[0]: expected a subject id string"},
+    {NULL, DFAUST_SUBJECTS("[\"50002\", \"a/b\"]"), NULL, "t.json: datasets[0].subjects[1]: 'a/b' may only"},
+    {NULL, DFAUST_SUBJECTS("[\"50002\", \"50002\"]"), NULL, "subjects[1]: duplicate subject '50002'"},
+    {NULL, DFAUST("\"root\": \"d\", \"frames\": 3, ", SEQ("hips", "test")), NULL,
+     "t.json: datasets[0].frames: unknown key"},
+    {NULL, DFAUST("\"root\": \"d\", \"align_rotation\": true, ", SEQ("hips", "test")), NULL,
+     "t.json: datasets[0].align_rotation: unknown key"},
+    {NULL, OBJDIR("\"subjects\": [\"1\"], "), NULL, "t.json: datasets[0].subjects: unknown key"},
 };
 
 static void test_bad_configs(void **state)
@@ -257,6 +270,50 @@ static void test_bad_configs(void **state)
             fail_msg("case %zu: rc %d, message \"%s\", expected \"%s\"", k, rc, err.msg, b->expect);
         assert_null(c.json_text); /* freed on error */
     }
+}
+
+/* "source": "dfaust": raw coordinates and draws with replacement unless
+ * told otherwise (§1.2, §1.3); every subject unless listed, the list in
+ * the normalized JSON. */
+static void test_dfaust_dataset(void **state)
+{
+    (void)state;
+    tcb_config c, again;
+    tcb_error err = {0};
+    const char *text =
+        config_text(NULL, DFAUST("\"root\": \"data/dfaust\", ", SEQ("jumping_jacks", "validation")), NULL);
+    assert_int_equal(tcb_config_parse(text, "t.json", &c, &err), TCB_OK);
+    const tcb_dataset_spec *d = &c.datasets[0];
+    assert_int_equal(d->source, TCB_SOURCE_DFAUST);
+    assert_string_equal(d->root, "data/dfaust");
+    assert_int_equal(d->norm, TCB_NORM_NONE);
+    assert_int_equal(d->with_replacement, 1);
+    assert_int_equal(d->n_subjects, 0);
+    assert_non_null(strstr(c.json_text, "\"source\":\t\"dfaust\""));
+    assert_non_null(strstr(c.json_text, "\"sampling\":\t\"with_replacement\""));
+    assert_null(strstr(c.json_text, "\"subjects\""));
+    assert_int_equal(tcb_config_parse(c.json_text, "normalized", &again, &err), TCB_OK);
+    assert_string_equal(again.json_text, c.json_text);
+    tcb_config_free(&again), tcb_config_free(&c);
+
+    text = config_text(NULL,
+                       DFAUST("\"root\": \"d\", \"optional\": true, \"normalization\": \"per_frame\", "
+                              "\"sampling\": \"without_replacement\", \"subjects\": [\"50004\", \"50002\"], ",
+                              SEQ("hips", "test")),
+                       NULL);
+    assert_int_equal(tcb_config_parse(text, "t.json", &c, &err), TCB_OK);
+    d = &c.datasets[0];
+    assert_int_equal(d->norm, TCB_NORM_PER_FRAME);
+    assert_int_equal(d->with_replacement, 0);
+    assert_int_equal(d->optional, 1);
+    assert_int_equal(d->n_subjects, 2);
+    assert_string_equal(d->subjects[0], "50004");
+    assert_string_equal(d->subjects[1], "50002");
+    assert_int_equal(tcb_config_parse(c.json_text, "normalized", &again, &err), TCB_OK);
+    assert_string_equal(again.json_text, c.json_text);
+    assert_int_equal(again.datasets[0].n_subjects, 2);
+    assert_string_equal(again.datasets[0].subjects[1], "50002");
+    tcb_config_free(&again), tcb_config_free(&c);
 }
 
 static void test_missing_lists_and_name(void **state)
@@ -328,6 +385,7 @@ int main(void)
         cmocka_unit_test(test_full_config),
         cmocka_unit_test(test_defaults),
         cmocka_unit_test(test_normalized_json),
+        cmocka_unit_test(test_dfaust_dataset),
         cmocka_unit_test(test_load_file),
         cmocka_unit_test(test_bad_configs),
         cmocka_unit_test(test_missing_lists_and_name),

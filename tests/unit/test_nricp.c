@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "methods/nricp/knn_compat.h"
+#include "methods/nricp/nricp_internal.h"
 #include "methods/nricp/register.h"
 #include "testutil.h"
 #include "tcb/fsutil.h"
@@ -674,6 +675,66 @@ static void test_input_shapes_checked(void **state)
     tcb_sequence_free(&s);
 }
 
+/* A sequence of two blocks (DFAUST subjects): within a block every
+ * strategy transfers as without blocks; the chains refuse a pair across
+ * blocks (random, one registration, does not); the maps across the
+ * boundary are not registered (the identity) and survive a checkpoint. */
+static void test_blocks(void **state)
+{
+    const char *dir = *state;
+    static const tcb_block blocks[] = {{"a", 0, 3}, {"b", 3, 3}};
+    tcb_sequence s;
+    make_blob_sequence(&s, 6);
+    const tcb_method_ops *ops = tcb_registry_find("nricp");
+    static const int pairs[][2] = {{0, 2}, {2, 0}, {4, 3}, {3, 5}};
+    float a[BLOB_VERTS * 3], b[BLOB_VERTS * 3];
+    tcb_rng rng;
+    tcb_rng_seed(&rng, 3);
+    for (size_t k = 0; k < 4; k++) {
+        void *plain = fitted(&s, all_strategies[k], 1, NULL);
+        s.blocks = malloc(sizeof blocks), s.n_blocks = 2;
+        memcpy(s.blocks, blocks, sizeof blocks);
+        void *split = fitted(&s, all_strategies[k], 1, NULL);
+        for (size_t t = 0; t < sizeof pairs / sizeof *pairs; t++) {
+            transfer(split, &s, pairs[t][0], pairs[t][1], a);
+            transfer(plain, &s, pairs[t][0], pairs[t][1], b);
+            assert_memory_equal(a, b, sizeof a);
+        }
+        tcb_error err = {0};
+        int rc = ops->transfer(split, &s, 2, 3, tcb_seq_frame(&s, 2), BLOB_VERTS, a, &rng, &err);
+        assert_int_equal(rc, k == NRICP_RANDOM ? TCB_OK : TCB_ERR_INPUT);
+        if (rc) assert_non_null(strstr(err.msg, "crosses the block boundary"));
+        if (nricp_uses_maps((nricp_strategy)k)) {
+            const nricp_method *m = split;
+            for (int v = 0; v < BLOB_VERTS; v++) {
+                assert_int_equal(m->maps[nricp_map_at(m, 2, 3) + (size_t)v], v);
+                assert_int_equal(m->maps[nricp_map_at(m, 3, 2) + (size_t)v], v);
+            }
+            char path[TCB_PATH_MAX];
+            void *loaded;
+            save_to(split, dir, "blocks.bin", path);
+            assert_int_equal(ops->create(all_strategies[k], &loaded, &err), TCB_OK);
+            if (ops->load(loaded, &s, path, &err)) fail_msg("load: %s", err.msg);
+            transfer(loaded, &s, 5, 3, a);
+            transfer(split, &s, 5, 3, b);
+            assert_memory_equal(a, b, sizeof a);
+            ops->destroy(loaded);
+            /* the same vertices without blocks are another sequence */
+            tcb_block *kept = s.blocks;
+            s.blocks = NULL, s.n_blocks = 0;
+            assert_int_equal(ops->create(all_strategies[k], &loaded, &err), TCB_OK);
+            assert_int_equal(ops->load(loaded, &s, path, &err), TCB_ERR_INPUT);
+            assert_non_null(strstr(err.msg, "another sequence"));
+            ops->destroy(loaded);
+            s.blocks = kept;
+        }
+        free(s.blocks);
+        s.blocks = NULL, s.n_blocks = 0;
+        ops->destroy(plain), ops->destroy(split);
+    }
+    tcb_sequence_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -694,6 +755,7 @@ int main(void)
                                         tu_teardown_tmpdir),
         cmocka_unit_test(test_bad_params_rejected),
         cmocka_unit_test(test_input_shapes_checked),
+        cmocka_unit_test_setup_teardown(test_blocks, tu_setup_tmpdir, tu_teardown_tmpdir),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

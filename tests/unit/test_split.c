@@ -1,4 +1,4 @@
-/* Evaluation splits (make, save/load, obtain) and training-pair samplers. */
+/* Evaluation splits (make, save/load, obtain, blocks) and training-pair samplers. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -18,7 +18,7 @@ static void make_ok(const char *seq, tcb_role role, int n_frames, int n_pairs, u
                     tcb_split *s)
 {
     tcb_error err = {0};
-    if (tcb_split_make("anim", seq, role, n_frames, n_pairs, seed, s, &err))
+    if (tcb_split_make("anim", seq, role, n_frames, NULL, 0, n_pairs, seed, s, &err))
         fail_msg("make: %s", err.msg);
 }
 
@@ -81,9 +81,9 @@ static void test_make_rejects(void **state)
     (void)state;
     tcb_split s;
     tcb_error err = {0};
-    expect_error(tcb_split_make("anim", "one", TCB_ROLE_TEST, 1, 10, 0, &s, &err), &err,
+    expect_error(tcb_split_make("anim", "one", TCB_ROLE_TEST, 1, NULL, 0, 10, 0, &s, &err), &err,
                  TCB_ERR_INPUT, "one", "2 frames");
-    expect_error(tcb_split_make("anim", "x", TCB_ROLE_TEST, 5, -1, 0, &s, &err), &err,
+    expect_error(tcb_split_make("anim", "x", TCB_ROLE_TEST, 5, NULL, 0, -1, 0, &s, &err), &err,
                  TCB_ERR_INPUT, "x", "negative");
 }
 
@@ -129,12 +129,12 @@ static void test_obtain_reuses(void **state)
     snprintf(path, sizeof path, "%s/splits/anim/cat_walk.json", dir);
     tcb_split a, b;
     tcb_error err = {0};
-    assert_int_equal(tcb_split_obtain(path, "anim", "cat_walk", TCB_ROLE_TEST, 35, 100, 3, &a, &err),
-                     TCB_OK);
+    assert_int_equal(
+        tcb_split_obtain(path, "anim", "cat_walk", TCB_ROLE_TEST, 35, NULL, 0, 100, 3, &a, &err), TCB_OK);
     struct stat st1, st2;
     file_identity(path, &st1, &before);
-    assert_int_equal(tcb_split_obtain(path, "anim", "cat_walk", TCB_ROLE_TEST, 35, 100, 3, &b, &err),
-                     TCB_OK);
+    assert_int_equal(
+        tcb_split_obtain(path, "anim", "cat_walk", TCB_ROLE_TEST, 35, NULL, 0, 100, 3, &b, &err), TCB_OK);
     file_identity(path, &st2, &after);
     assert_true(st1.st_ino == st2.st_ino); /* an atomic rewrite would be a new inode */
     assert_true(st1.st_mtim.tv_sec == st2.st_mtim.tv_sec &&
@@ -150,7 +150,8 @@ static void test_obtain_reuses(void **state)
                   " \"role\": \"test\", \"n_frames\": 4, \"seed\": 1, \"n_pairs\": 2,"
                   " \"pairs\": [[3, 0], [3, 0]]}",
                   path, sizeof path);
-    assert_int_equal(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_TEST, 4, 2, 1, &a, &err), TCB_OK);
+    assert_int_equal(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_TEST, 4, NULL, 0, 2, 1, &a, &err),
+                     TCB_OK);
     assert_true(a.pairs[0] == 3 && a.pairs[1] == 0 && a.pairs[2] == 3 && a.pairs[3] == 0);
     tcb_split_free(&a);
     tu_remove_tree(dir);
@@ -164,20 +165,21 @@ static void test_obtain_disagreement(void **state)
     snprintf(path, sizeof path, "%s/cat.json", dir);
     tcb_split s;
     tcb_error err = {0};
-    assert_int_equal(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_TEST, 35, 50, 3, &s, &err), TCB_OK);
+    assert_int_equal(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_TEST, 35, NULL, 0, 50, 3, &s, &err),
+                     TCB_OK);
     tcb_split_free(&s);
-    expect_error(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_VALIDATION, 35, 50, 3, &s, &err),
+    expect_error(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_VALIDATION, 35, NULL, 0, 50, 3, &s, &err),
                  &err, TCB_ERR_INPUT, path, "role");
     assert_null(s.pairs);
-    expect_error(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_TEST, 36, 50, 3, &s, &err), &err,
+    expect_error(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_TEST, 36, NULL, 0, 50, 3, &s, &err), &err,
                  TCB_ERR_INPUT, path, "n_frames");
-    expect_error(tcb_split_obtain(path, "anim", "dog", TCB_ROLE_TEST, 35, 50, 3, &s, &err), &err,
+    expect_error(tcb_split_obtain(path, "anim", "dog", TCB_ROLE_TEST, 35, NULL, 0, 50, 3, &s, &err), &err,
                  TCB_ERR_INPUT, path, "sequence");
-    expect_error(tcb_split_obtain(path, "ama", "cat", TCB_ROLE_TEST, 35, 50, 3, &s, &err), &err,
+    expect_error(tcb_split_obtain(path, "ama", "cat", TCB_ROLE_TEST, 35, NULL, 0, 50, 3, &s, &err), &err,
                  TCB_ERR_INPUT, path, "dataset");
-    expect_error(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_TEST, 35, 500, 3, &s, &err), &err,
+    expect_error(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_TEST, 35, NULL, 0, 500, 3, &s, &err), &err,
                  TCB_ERR_INPUT, path, "n_pairs");
-    expect_error(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_TEST, 35, 50, 4, &s, &err), &err,
+    expect_error(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_TEST, 35, NULL, 0, 50, 4, &s, &err), &err,
                  TCB_ERR_INPUT, path, "seed");
     tu_remove_tree(dir);
 }
@@ -262,24 +264,24 @@ static void test_names(void **state)
     assert_int_equal(tcb_pair_mode_parse("neighbours", &mode), -1);
 }
 
-/* Draws 40 j per frame for every i (a given allowed j is then missed with
- * probability < e^-39); every j must be allowed and every allowed j seen. */
-static void check_sampler(tcb_pair_mode mode, int delta, int n, tcb_rng *rng)
+/* Draws 40 j per frame for every i of the block [lo, hi) (a given allowed
+ * j is then missed with probability < e^-39); every j must be allowed and
+ * every allowed j seen. */
+static void check_sampler(tcb_pair_mode mode, int delta, int n, int lo, int hi, tcb_rng *rng)
 {
-    for (int i = 0; i < n; i++) {
+    for (int i = lo; i < hi; i++) {
         int seen[64] = {0};
         for (int t = 0; t < 40 * n; t++) {
-            int j = tcb_pair_sample(mode, delta, n, i, rng);
+            int j = tcb_pair_sample(mode, delta, n, lo, hi, i, rng);
             assert_in_range(j, 0, n - 1);
-            assert_int_not_equal(j, i);
-            if (mode == TCB_PAIRS_NEIGHBORS) assert_true(abs(i - j) <= delta);
             seen[j] = 1;
         }
         for (int j = 0; j < n; j++) {
-            int allowed = j != i && (mode != TCB_PAIRS_NEIGHBORS || abs(i - j) <= delta);
+            int in_block = mode == TCB_PAIRS_RANDOM || (j >= lo && j < hi);
+            int allowed = j != i && in_block && (mode != TCB_PAIRS_NEIGHBORS || abs(i - j) <= delta);
             if (seen[j] != allowed)
-                fail_msg("mode %d, delta %d, %d frames, i = %d: j = %d seen %d", (int)mode,
-                         delta, n, i, j, seen[j]);
+                fail_msg("mode %d, delta %d, %d frames, block [%d, %d), i = %d: j = %d seen %d", (int)mode,
+                         delta, n, lo, hi, i, j, seen[j]);
         }
     }
 }
@@ -292,15 +294,143 @@ static void test_pair_samplers(void **state)
     static const int ns[] = {2, 3, 10, 48};
     static const int deltas[] = {1, 2, 5, 100};
     for (size_t a = 0; a < 4; a++) {
-        for (size_t b = 0; b < 4; b++) check_sampler(TCB_PAIRS_NEIGHBORS, deltas[b], ns[a], &rng);
-        check_sampler(TCB_PAIRS_RANDOM, 0, ns[a], &rng);
-        check_sampler(TCB_PAIRS_WITHIN_SEQ, 0, ns[a], &rng);
+        for (size_t b = 0; b < 4; b++) check_sampler(TCB_PAIRS_NEIGHBORS, deltas[b], ns[a], 0, ns[a], &rng);
+        check_sampler(TCB_PAIRS_RANDOM, 0, ns[a], 0, ns[a], &rng);
+        check_sampler(TCB_PAIRS_WITHIN_SEQ, 0, ns[a], 0, ns[a], &rng);
     }
-    assert_int_equal(tcb_pair_sample(TCB_PAIRS_RANDOM, 1, 1, 0, &rng), -1);
-    assert_int_equal(tcb_pair_sample(TCB_PAIRS_NEIGHBORS, 1, 0, 0, &rng), -1);
-    assert_int_equal(tcb_pair_sample(TCB_PAIRS_NEIGHBORS, 0, 10, 3, &rng), -1);
-    assert_int_equal(tcb_pair_sample(TCB_PAIRS_WITHIN_SEQ, 1, 10, 10, &rng), -1);
-    assert_int_equal(tcb_pair_sample(TCB_PAIRS_WITHIN_SEQ, 1, 10, -1, &rng), -1);
+    /* blocks: the windows and within_seq stay inside, random crosses */
+    static const int blocks[][2] = {{0, 2}, {2, 9}, {9, 12}, {3, 48}};
+    for (size_t k = 0; k < 4; k++) {
+        int n = k < 3 ? 12 : 48, lo = blocks[k][0], hi = blocks[k][1];
+        for (size_t b = 0; b < 4; b++) check_sampler(TCB_PAIRS_NEIGHBORS, deltas[b], n, lo, hi, &rng);
+        check_sampler(TCB_PAIRS_RANDOM, 0, n, lo, hi, &rng);
+        check_sampler(TCB_PAIRS_WITHIN_SEQ, 0, n, lo, hi, &rng);
+    }
+    assert_int_equal(tcb_pair_sample(TCB_PAIRS_RANDOM, 1, 1, 0, 1, 0, &rng), -1);
+    assert_int_equal(tcb_pair_sample(TCB_PAIRS_NEIGHBORS, 1, 0, 0, 0, 0, &rng), -1);
+    assert_int_equal(tcb_pair_sample(TCB_PAIRS_NEIGHBORS, 0, 10, 0, 10, 3, &rng), -1);
+    assert_int_equal(tcb_pair_sample(TCB_PAIRS_WITHIN_SEQ, 1, 10, 0, 10, 10, &rng), -1);
+    assert_int_equal(tcb_pair_sample(TCB_PAIRS_WITHIN_SEQ, 1, 10, 0, 10, -1, &rng), -1);
+    assert_int_equal(tcb_pair_sample(TCB_PAIRS_WITHIN_SEQ, 1, 10, 4, 6, 3, &rng), -1);  /* i outside */
+    assert_int_equal(tcb_pair_sample(TCB_PAIRS_RANDOM, 1, 10, 4, 5, 4, &rng), -1);      /* 1-frame block */
+    assert_int_equal(tcb_pair_sample(TCB_PAIRS_NEIGHBORS, 1, 10, 8, 11, 9, &rng), -1);  /* block past n */
+}
+
+static const tcb_block two_blocks[] = {{"50002", 0, 3}, {"50004", 3, 6}};
+
+/* §5.2 with blocks: i uniform over all frames, j inside i's block, and the
+ * file records the blocks. */
+static void test_blocks_split(void **state)
+{
+    const char *dir = *state;
+    enum { P = 9000 };
+    tcb_split s, t;
+    tcb_error err = {0};
+    assert_int_equal(tcb_split_make("dfaust", "hips", TCB_ROLE_TEST, 9, two_blocks, 2, P, 5, &s, &err),
+                     TCB_OK);
+    int count[9] = {0};
+    for (int p = 0; p < P; p++) {
+        int i = s.pairs[2 * p], j = s.pairs[2 * p + 1];
+        assert_int_not_equal(i, j);
+        assert_int_equal(i < 3, j < 3);
+        count[i]++;
+    }
+    for (int f = 0; f < 9; f++) assert_in_range(count[f], P / 9 - 150, P / 9 + 150); /* ~5 sigma */
+    char path[512], *text;
+    snprintf(path, sizeof path, "%s/hips.json", dir);
+    assert_int_equal(tcb_split_save(path, &s, &err), TCB_OK);
+    assert_int_equal(tcb_split_load(path, &t, &err), TCB_OK);
+    assert_int_equal(t.n_blocks, 2);
+    assert_string_equal(t.blocks[1].name, "50004");
+    assert_int_equal(t.blocks[1].start, 3);
+    assert_int_equal(t.blocks[1].n_frames, 6);
+    assert_memory_equal(s.pairs, t.pairs, P * 2 * sizeof(int32_t));
+    assert_int_equal(tcb_read_file(path, &text, NULL, &err), TCB_OK);
+    assert_non_null(strstr(text, "\"blocks\""));
+    free(text);
+    tcb_split_free(&s), tcb_split_free(&t);
+
+    /* One block draws what a block-less split over the same frames draws. */
+    static const tcb_block whole[] = {{"50002", 0, 9}};
+    make_ok("hips", TCB_ROLE_TEST, 9, 100, 5, &s);
+    assert_int_equal(tcb_split_make("anim", "hips", TCB_ROLE_TEST, 9, whole, 1, 100, 5, &t, &err), TCB_OK);
+    assert_memory_equal(s.pairs, t.pairs, 100 * 2 * sizeof(int32_t));
+    tcb_split_free(&s), tcb_split_free(&t);
+}
+
+/* The split of 9 frames at path asked for with other blocks: refused,
+ * naming the file and `field`. */
+static void expect_blocks_refused(const char *path, const tcb_block *blocks, int n_blocks, const char *field)
+{
+    tcb_split s;
+    tcb_error err = {0};
+    expect_error(tcb_split_obtain(path, "d", "hips", TCB_ROLE_TEST, 9, blocks, n_blocks, 20, 3, &s, &err), &err,
+                 TCB_ERR_INPUT, path, field);
+    assert_null(s.pairs);
+}
+
+static void test_blocks_disagreement(void **state)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/hips.json", (const char *)*state);
+    tcb_split s;
+    tcb_error err = {0};
+    for (int k = 0; k < 2; k++) { /* made, then reused */
+        assert_int_equal(tcb_split_obtain(path, "d", "hips", TCB_ROLE_TEST, 9, two_blocks, 2, 20, 3, &s, &err),
+                         TCB_OK);
+        tcb_split_free(&s);
+    }
+    static const tcb_block moved[] = {{"50002", 0, 4}, {"50004", 4, 5}};
+    static const tcb_block renamed[] = {{"50002", 0, 3}, {"50007", 3, 6}};
+    expect_blocks_refused(path, moved, 2, "blocks[0] is \"50002\" frames [0, 3)");
+    expect_blocks_refused(path, renamed, 2, "blocks[1] is \"50004\"");
+    expect_blocks_refused(path, NULL, 0, "blocks is 2 blocks in the split file but no blocks");
+    /* malformed requests: blocks that do not tile the frames */
+    static const tcb_block gap[] = {{"a", 0, 3}, {"b", 4, 5}};
+    static const tcb_block dup[] = {{"a", 0, 3}, {"a", 3, 6}};
+    static const tcb_block one[] = {{"a", 0, 8}, {"b", 8, 1}};
+    expect_error(tcb_split_make("d", "x", TCB_ROLE_TEST, 9, gap, 2, 5, 0, &s, &err), &err, TCB_ERR_INPUT,
+                 "blocks[1].start", NULL);
+    expect_error(tcb_split_make("d", "x", TCB_ROLE_TEST, 9, dup, 2, 5, 0, &s, &err), &err, TCB_ERR_INPUT,
+                 "blocks[1].name", NULL);
+    expect_error(tcb_split_make("d", "x", TCB_ROLE_TEST, 9, one, 2, 5, 0, &s, &err), &err, TCB_ERR_INPUT,
+                 "blocks[1].n_frames", NULL);
+    expect_error(tcb_split_make("d", "x", TCB_ROLE_TEST, 10, two_blocks, 2, 5, 0, &s, &err), &err,
+                 TCB_ERR_INPUT, "cover 9 frames of 10", NULL);
+}
+
+/* A split file's blocks are checked like its pairs. */
+static void test_blocks_malformed(void **state)
+{
+    const char *dir = *state;
+#define HEAD                                                                                 \
+    "{\"format\": \"tcbench-split/1\", \"dataset\": \"d\", \"sequence\": \"s\", \"role\": \"test\", " \
+    "\"n_frames\": 4, \"seed\": 1, \"n_pairs\": 1, "
+    static const struct {
+        const char *json, *key;
+    } cases[] = {
+        {HEAD "\"blocks\": [], \"pairs\": [[0, 1]]}", ".blocks"},
+        {HEAD "\"blocks\": {}, \"pairs\": [[0, 1]]}", ".blocks"},
+        {HEAD "\"blocks\": [{\"name\": \"a\", \"start\": 0}], \"pairs\": [[0, 1]]}", ".blocks[0].n_frames"},
+        {HEAD "\"blocks\": [{\"name\": \"a\", \"start\": 0, \"n_frames\": 4, \"x\": 1}], "
+              "\"pairs\": [[0, 1]]}",
+         ".blocks[0].x"},
+        {HEAD "\"blocks\": [{\"name\": \"a\", \"start\": 0, \"n_frames\": 3}], \"pairs\": [[0, 1]]}",
+         ".blocks: the blocks cover 3"},
+        {HEAD "\"blocks\": [{\"name\": \"a\", \"start\": 0, \"n_frames\": 2}, "
+              "{\"name\": \"b\", \"start\": 2, \"n_frames\": 2}], \"pairs\": [[1, 2]]}",
+         ".pairs[0]: frames 1 and 2 are in different blocks"},
+    };
+#undef HEAD
+    for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
+        char path[512];
+        tu_write_text(dir, "bad.json", cases[c].json, path, sizeof path);
+        tcb_split s;
+        tcb_error err = {0};
+        expect_error(tcb_split_load(path, &s, &err), &err, TCB_ERR_INPUT, path, cases[c].key);
+        assert_null(s.pairs);
+        assert_null(s.blocks);
+    }
 }
 
 int main(void)
@@ -315,6 +445,9 @@ int main(void)
         cmocka_unit_test(test_load_malformed),
         cmocka_unit_test(test_names),
         cmocka_unit_test(test_pair_samplers),
+        cmocka_unit_test_setup_teardown(test_blocks_split, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test_setup_teardown(test_blocks_disagreement, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test_setup_teardown(test_blocks_malformed, tu_setup_tmpdir, tu_teardown_tmpdir),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
