@@ -6,7 +6,7 @@
  * sized from its first OBJ file (or generated, for synthetic data); each
  * method estimates its own cost from its measured step costs
  * (tcb_method_ops.estimate), and the harness adds its projection and
- * metrics, whose rank term compares every pair of target vertices. */
+ * metrics. */
 #include <stdio.h>
 #include <string.h>
 
@@ -15,8 +15,10 @@
 #include "tcb/registry.h"
 #include "tcb/synth.h"
 
-/* The rank metric per pair: 0.11 s at 10 002 vertices (nearest on crane:
- * 55 s for 500 pairs, one thread, Zen 4), quadratic in the vertex count. */
+/* The harness's projection and metrics per pair: 0.11 s at 10 002 vertices
+ * (nearest on crane: 55 s for 500 pairs, one thread, Zen 4), scaled with
+ * the square of the vertex count, an upper bound (the rank compares only
+ * nearby vertices, docs/protocol.md). */
 #define METRICS_S_PER_VERT2 (0.11 / (10002.0 * 10002.0))
 
 typedef struct plan_totals {
