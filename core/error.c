@@ -50,11 +50,13 @@ const char *tcb_status_name(tcb_status code)
     case TCB_ERR_NUMERIC: return "numeric";
     case TCB_ERR_UNSUPPORTED: return "unsupported";
     case TCB_ERR_INTERNAL: return "internal";
+    case TCB_ERR_INTERRUPTED: return "interrupted";
     }
     return "unknown";
 }
 
 int tcb_status_exit_code(tcb_status code)
 {
+    if (code == TCB_ERR_INTERRUPTED) return TCB_EXIT_INTERRUPTED;
     return code == TCB_ERR_INPUT || code == TCB_ERR_IO ? 2 : 1;
 }

@@ -132,7 +132,8 @@ static int prepare_method(const tcb_cell_job *job, void **self, double *fit_s, t
         rc = create_method(job, self, merr);
         if (rc) return rc;
     }
-    tcb_fit_ctx ctx = {(uint64_t)job->seed, job->threads, job->work_dir, job->reporter, &earlier};
+    tcb_fit_ctx ctx = {(uint64_t)job->seed, job->threads, job->work_dir, job->reporter, &earlier,
+                       job->interrupted, job->interrupt_arg};
     rc = ops->fit(*self, job->seq, &ctx, merr);
     double spent = earlier + tcb_now_seconds() - t0;
     if (fit_s) *fit_s = spent;
@@ -236,6 +237,11 @@ static void evaluate(const tcb_cell_job *job, void *self, tcb_cell_result *c, tc
                        job->method->label, job->seed);
         tcb_report_progress(&job->reporter, 0, split->n_pairs, label);
         for (int k = 0; k < split->n_pairs && !merr->code && !herr->code; k++) {
+            if (job->interrupted && job->interrupted(job->interrupt_arg)) {
+                tcb_fail(herr, TCB_ERR_INTERRUPTED, "stopped at pair %d of %d of the evaluation (the fitted model is kept)",
+                         k, split->n_pairs);
+                break;
+            }
             eval_pair(job, self, k, &b, &c->pairs[k], &c->summary, NULL, merr, herr);
             tcb_report_progress(&job->reporter, k + 1, split->n_pairs, label);
         }
@@ -290,6 +296,7 @@ static int run_cell(const tcb_cell_job *job, tcb_cell_result *out, tcb_error *er
     }
     out->eval_s = tcb_now_seconds() - t1;
     out->peak_rss_kb = tcb_peak_rss_kb();
+    if (merr.code == TCB_ERR_INTERRUPTED) herr = merr; /* not the cell's failure: it resumes */
     if (herr.code) goto fail;
     if (merr.code) record_failure(out, &merr);
     return TCB_OK;

@@ -7,6 +7,8 @@
 
 #include <cjson/cJSON.h>
 #include <pthread.h>
+#include <signal.h>
+#include <stdatomic.h>
 
 #include "tcb/config.h"
 #include "tcb/method.h"
@@ -80,6 +82,21 @@ void tcb_cell_lock_release(tcb_cell_lock *l);
 /* The lock file at `path` (<cell>.json.lock): 0, or -1 when there is none. */
 int tcb_cell_lock_read(const char *path, tcb_lock_info *info);
 
+/* SIGTERM / SIGUSR1 as a stop request (harness/stop_signals.c): start
+ * blocks them in the calling thread (call it before any other thread
+ * exists) and starts the thread that waits for them; requested() is the
+ * signal received, 0 before one (a tcb_run_opts.interrupted); end restores
+ * the mask. */
+typedef struct tcb_stop_signals {
+    sigset_t set, old;
+    pthread_t thread;
+    int started;
+    atomic_int signal, closing;
+} tcb_stop_signals;
+int tcb_stop_signals_start(tcb_stop_signals *s);
+int tcb_stop_signals_requested(const void *s);
+void tcb_stop_signals_end(tcb_stop_signals *s);
+
 /* Short git revision of the source tree tcbench was built from, or
  * "unknown". (harness/sysinfo.c) */
 void tcb_git_revision(char *out, size_t size);
@@ -131,6 +148,8 @@ typedef struct tcb_cell_job {
     const char *git_revision;
     double load_s;            /* time spent loading the sequence */
     tcb_reporter reporter;
+    int (*interrupted)(const void *arg); /* may be NULL: see tcb_fit_ctx */
+    const void *interrupt_arg;
 } tcb_cell_job;
 
 /* The seconds fitting a cell's model took, stored beside its checkpoint

@@ -169,9 +169,13 @@ static int cmd_run(const cli *c)
         free(mask);
         return 2;
     }
+    tcb_stop_signals stop;
     tcb_run_opts opts = {.output = c->value[F_OUT], .only_method = c->value[F_ONLY], .force = c->set[F_FORCE],
                          .reporter = c->set[F_DRY_RUN] ? (tcb_reporter){0} : tcb_term_progress_reporter(&tp),
-                         .cells = mask, .lock_timeout_s = (double)lock_timeout};
+                         .cells = mask, .lock_timeout_s = (double)lock_timeout,
+                         .interrupted = tcb_stop_signals_requested, .interrupt_arg = &stop};
+    /* Before any thread exists, so that every thread blocks the signals. */
+    if (tcb_stop_signals_start(&stop)) fprintf(stderr, "tcbench: cannot watch for SIGTERM; a signal kills the run\n");
     tcb_run_stats st;
     rc = c->set[F_DRY_RUN] ? tcb_run_dry(&cfg, &opts, stdout, &err) : tcb_run(&cfg, &opts, &st, &err);
     tcb_term_progress_finish(&tp);
@@ -179,8 +183,30 @@ static int cmd_run(const cli *c)
     snprintf(run_dir, sizeof run_dir, "%s", opts.output ? opts.output : cfg.output);
     tcb_config_free(&cfg);
     free(mask);
+    tcb_stop_signals_end(&stop);
     if (rc) return fail(&err);
     return c->set[F_DRY_RUN] ? 0 : finish_run(c, run_dir, &st);
+}
+
+/* `tcbench status RUN_DIR|CONFIG`: a run directory is read through the
+ * config it saved (<run>/config.json, already resolved). */
+static int cmd_status(const cli *c)
+{
+    tcb_error err = {0};
+    tcb_config cfg;
+    char saved[TCB_PATH_MAX];
+    cli resolved = *c;
+    if (tcb_is_dir(c->arg[0])) {
+        if (tcb_path_join(saved, sizeof saved, &err, "%s/config.json", c->arg[0])) return fail(&err);
+        resolved.arg[0] = saved;
+        if (!resolved.value[F_OUT]) resolved.value[F_OUT] = c->arg[0];
+    }
+    int rc = load_config(&resolved, &cfg);
+    if (rc) return rc;
+    tcb_run_opts opts = {.output = resolved.value[F_OUT]};
+    rc = tcb_run_status(&cfg, &opts, stdout, &err);
+    tcb_config_free(&cfg);
+    return rc ? fail(&err) : 0;
 }
 
 static int cmd_cells(const cli *c)
@@ -415,6 +441,21 @@ static const command commands[] = {
      "\n"
      "example:\n"
      "  tcbench cells configs/paper/table5-nricp.json\n"},
+    {"status", cmd_status, BIT(F_OUT) | BIT(F_ROOT) | BIT(F_VARIANT), 1, 1, "RUN_DIR or CONFIG",
+     "usage: tcbench status RUN_DIR|CONFIG [--variant NAME] [--out DIR]\n"
+     "\n"
+     "Where a run stands: the running cells (host, pid, heartbeat age), the failed\n"
+     "and diverged ones with their messages, the count per state, and the ids of\n"
+     "the missing cells as a Slurm --array list to resubmit. A run directory is\n"
+     "read through the config it saved (RUN_DIR/config.json).\n"
+     "\n"
+     "options:\n"
+     "  --variant NAME  with a CONFIG: its variant (default: the first)\n"
+     "  --out DIR       with a CONFIG: the run directory (default: its \"output\")\n"
+     "\n"
+     "examples:\n"
+     "  tcbench status runs/paper/table6-delta/cpu\n"
+     "  sbatch --array=$(tcbench status runs/x | sed -n 's/.*--array=//p') ...\n"},
     {"report", cmd_report, BIT(F_OUT) | BIT(F_QUIET) | BIT(F_REFERENCE), 1, 1, "RUN_DIR",
      "usage: tcbench report RUN_DIR [--reference NAME] [--out DIR] [--quiet]\n"
      "\n"
@@ -539,6 +580,7 @@ static const char general_help[] =
     "commands:\n"
     "  run       run the grid of a config (resumable)\n"
     "  cells     the numbered cells of a config and their state\n"
+    "  status    where a run stands; the missing cells as a Slurm --array list\n"
     "  report    tables and plots from a run directory\n"
     "  methods   list the registered methods\n"
     "  datasets  list or export the synthetic sequences, align an OBJ sequence's rotations\n"

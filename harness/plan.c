@@ -58,9 +58,10 @@ static void probe(const tcb_dataset_spec *d, const char *name, int *n_frames, in
 
 /* done, failed, diverged, unreadable, missing, or "running (host pid, age)"
  * while a lock of a live holder is on a cell without a result. */
-static void cell_state(const char *run_dir, const tcb_dataset_spec *d, const char *seq, const tcb_method_spec *m,
-                       int seed, char *out, size_t size)
+static void cell_state_message(const char *run_dir, const tcb_dataset_spec *d, const char *seq,
+                               const tcb_method_spec *m, int seed, char *out, size_t size, char *msg, size_t msg_size)
 {
+    if (msg) msg[0] = '\0';
     char path[TCB_PATH_MAX], lock[TCB_PATH_MAX + 8];
     tcb_error err = {0};
     snprintf(out, size, "missing");
@@ -78,7 +79,14 @@ static void cell_state(const char *run_dir, const tcb_dataset_spec *d, const cha
         return;
     }
     snprintf(out, size, "%s", c.status == TCB_CELL_OK ? "done" : tcb_cell_status_name(c.status));
+    if (msg) snprintf(msg, msg_size, "%s", c.message);
     tcb_cell_free(&c);
+}
+
+static void cell_state(const char *run_dir, const tcb_dataset_spec *d, const char *seq, const tcb_method_spec *m,
+                       int seed, char *out, size_t size)
+{
+    cell_state_message(run_dir, d, seq, m, seed, out, size, NULL, 0);
 }
 
 static void estimate_cell(const tcb_method_spec *m, const tcb_cost_query *q, tcb_cost_estimate *e)
@@ -192,4 +200,64 @@ int tcb_run_list_cells(const tcb_config *cfg, const tcb_run_opts *opts, FILE *ou
     list_walk w = {out, opts->output ? opts->output : cfg->output};
     fprintf(out, "%5s  %-12s %-20s %-24s %4s  %s\n", "id", "dataset", "sequence", "method", "seed", "state");
     return tcb_grid_for_each(cfg, list_cell, &w);
+}
+
+/* ---- tcbench status ---------------------------------------------------- */
+
+typedef struct status_walk {
+    FILE *out;
+    const char *run_dir;
+    int n_done, n_failed, n_running, n_missing;
+    int range_lo, range_hi;    /* the missing ids' current run, -1: none */
+    char array[4096];          /* the missing ids as Slurm's --array list */
+    char failures[8192];
+} status_walk;
+
+static void flush_range(status_walk *w)
+{
+    if (w->range_lo < 0) return;
+    const char *sep = w->array[0] ? "," : "";
+    size_t used = strlen(w->array);
+    if (w->range_lo == w->range_hi) snprintf(w->array + used, sizeof w->array - used, "%s%d", sep, w->range_lo);
+    else snprintf(w->array + used, sizeof w->array - used, "%s%d-%d", sep, w->range_lo, w->range_hi);
+    w->range_lo = w->range_hi = -1;
+}
+
+static int status_cell(void *ctx, const tcb_grid_cell *c)
+{
+    status_walk *w = ctx;
+    char state[TCB_PATH_MAX], msg[TCB_ERRMSG_MAX];
+    cell_state_message(w->run_dir, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state, msg,
+                       sizeof msg);
+    int missing = !strcmp(state, "missing") || !strcmp(state, "unreadable");
+    if (!strcmp(state, "done")) w->n_done++;
+    else if (!strncmp(state, "running", 7)) {
+        w->n_running++;
+        fprintf(w->out, "running  %5d  %s/%s/%s seed %d: %s\n", c->id, c->dataset->name, c->sequence->name,
+                c->method->label, c->seed, state + 8);
+    } else if (!missing) {
+        w->n_failed++;
+        size_t used = strlen(w->failures);
+        snprintf(w->failures + used, sizeof w->failures - used, "%-8s %5d  %s/%s/%s seed %d: %s\n", state, c->id,
+                 c->dataset->name, c->sequence->name, c->method->label, c->seed, msg);
+    }
+    if (missing) {
+        w->n_missing++;
+        if (w->range_hi >= 0 && c->id == w->range_hi + 1) w->range_hi = c->id;
+        else flush_range(w), w->range_lo = w->range_hi = c->id;
+    }
+    return TCB_OK;
+}
+
+int tcb_run_status(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_error *err)
+{
+    (void)err;
+    status_walk w = {.out = out, .run_dir = opts->output ? opts->output : cfg->output, .range_lo = -1, .range_hi = -1};
+    tcb_grid_for_each(cfg, status_cell, &w);
+    flush_range(&w);
+    fputs(w.failures, out);
+    fprintf(out, "%s: %d cells: %d done, %d failed or diverged, %d running, %d missing\n", w.run_dir,
+            tcb_grid_count(cfg), w.n_done, w.n_failed, w.n_running, w.n_missing);
+    if (w.n_missing) fprintf(out, "resubmit the missing cells: --array=%s\n", w.array);
+    return TCB_OK;
 }

@@ -244,6 +244,8 @@ static int run_cell(const run_state *st, const seq_ctx *sc, const tcb_method_spe
         .git_revision = st->git_revision,
         .load_s = sc->load_s,
         .reporter = st->opts->reporter,
+        .interrupted = st->opts->interrupted,
+        .interrupt_arg = st->opts->interrupt_arg,
     };
     char label[TCB_CELL_LABEL_MAX];
     tcb_cell_label(label, sizeof label, sc->dataset->name, sc->seq->name, m->label, seed);
@@ -330,6 +332,8 @@ static int run_cells(const run_state *st, const seq_ctx *sc, int first, tcb_erro
         if (!tcb_method_runs_on(m, sc->dataset->name)) continue;
         for (int s = 0; s < m->n_seeds; s++, id++) {
             if (!cell_wanted(st->opts, id, m)) continue;
+            if (st->opts->interrupted && st->opts->interrupted(st->opts->interrupt_arg))
+                return tcb_fail(err, TCB_ERR_INTERRUPTED, "stopped before cell %d", id);
             char path[TCB_PATH_MAX];
             int rc = tcb_cell_path(path, sizeof path, st->run_dir, sc->dataset->name,
                                    sc->seq->name, m->label, m->seeds[s], err);

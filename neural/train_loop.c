@@ -33,8 +33,8 @@ static int run(const tcb_train_loop *loop, const tcb_fit_ctx *ctx, tcb_error *er
     double start = tcb_now_seconds(), earlier = 0;
     char ckpt[TCB_PATH_MAX] = "";
     int rc = TCB_OK;
-    if (ctx->work_dir && loop->checkpoint_every > 0)
-        rc = tcb_path_join(ckpt, sizeof ckpt, err, "%s/%s", ctx->work_dir, loop->ckpt_name);
+    /* Also without periodic checkpoints: a stop request saves one. */
+    if (ctx->work_dir) rc = tcb_path_join(ckpt, sizeof ckpt, err, "%s/%s", ctx->work_dir, loop->ckpt_name);
     if (!rc) resume(loop, ctx, ckpt, &earlier);
     long long total = loop->iterations, every = log_interval(total), since = 0;
     double sum = 0;
@@ -50,8 +50,13 @@ static int run(const tcb_train_loop *loop, const tcb_fit_ctx *ctx, tcb_error *er
                            loop->name, done, sum / (double)since, since);
             sum = 0, since = 0;
         }
-        if (!rc && ckpt[0] && done % loop->checkpoint_every == 0 && done < total)
+        int periodic = loop->checkpoint_every > 0 && done % loop->checkpoint_every == 0;
+        int stop = !rc && done < total && tcb_fit_interrupted(ctx);
+        if (!rc && ckpt[0] && (periodic || stop) && done < total)
             rc = loop->save(loop->trainer, earlier + tcb_now_seconds() - start, ckpt, err);
+        if (!rc && stop)
+            return tcb_fail(err, TCB_ERR_INTERRUPTED, "stopped at iteration %lld of %lld%s%s", done, total,
+                            ckpt[0] ? "; training state saved in " : " (no work directory: nothing saved)", ckpt);
     }
     if (ctx->resumed_fit_s) *ctx->resumed_fit_s = earlier;
     if (!rc && ckpt[0]) remove(ckpt);

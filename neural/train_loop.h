@@ -2,7 +2,8 @@
  * from the cell's training checkpoint when there is one, step to the last
  * iteration with a progress bar and a debug line with the mean loss every
  * 1 000 iterations (a tenth of a shorter training),
- * save the training state every `checkpoint_every` iterations, and delete
+ * save the training state every `checkpoint_every` iterations (and when
+ * ctx asks it to stop: then it returns TCB_ERR_INTERRUPTED), and delete
  * it at the end (the harness's model checkpoint supersedes it). A
  * checkpoint that cannot be continued (corrupt, other settings) is reported
  * and ignored: training starts over, as the harness does with a bad model

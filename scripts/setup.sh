@@ -18,6 +18,7 @@ packages=(
 )
 if [ "${1:-}" = "--tests" ]; then
   packages+=(python3-torch)               # the atlas network and training step against PyTorch
+  packages+=(slurm-wlm munge)             # the one-node Slurm cluster of tests/integration/test_slurm.sh
 elif [ $# -gt 0 ]; then
   echo "usage: scripts/setup.sh [--tests]" >&2; exit 2
 fi

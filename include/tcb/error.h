@@ -18,7 +18,8 @@ typedef enum tcb_status {
     TCB_ERR_NOMEM = 3,
     TCB_ERR_NUMERIC = 4,     /* NaN/Inf or divergence inside a method */
     TCB_ERR_UNSUPPORTED = 5, /* an optional capability the caller asked for is absent */
-    TCB_ERR_INTERNAL = 6
+    TCB_ERR_INTERNAL = 6,
+    TCB_ERR_INTERRUPTED = 7  /* stopped by a signal at a safe point, state saved: rerun to resume */
 } tcb_status;
 
 #define TCB_ERRMSG_MAX 1024
@@ -42,6 +43,11 @@ void tcb_error_clear(tcb_error *err);
 
 /* Short stable name of a status ("input", "io", ...), used in results files. */
 const char *tcb_status_name(tcb_status code);
+
+/* The exit status of a run stopped by SIGTERM or SIGUSR1 (Slurm's
+ * preemption and --signal) once its state is saved: sysexits' EX_TEMPFAIL,
+ * which scripts/slurm/tcbench-array.sbatch requeues on. */
+#define TCB_EXIT_INTERRUPTED 75
 
 /* Process exit status for a failed command: 2 for bad input or unreadable
  * paths, 1 otherwise. */

@@ -53,7 +53,18 @@ typedef struct tcb_fit_ctx {
                              * seconds that state cost the earlier processes, so
                              * the cell's fit_s counts the whole fit. Appended
                              * last: tables built before it ignore it */
+    /* May be NULL. Nonzero once the process was asked to stop (SIGTERM,
+     * SIGUSR1): a long fit saves its state in work_dir at the next safe
+     * point and returns TCB_ERR_INTERRUPTED; the next run resumes it. A fit
+     * that ignores it is killed with the process. Appended last, as above. */
+    int (*interrupted)(const void *arg);
+    const void *interrupt_arg;
 } tcb_fit_ctx;
+
+static inline int tcb_fit_interrupted(const tcb_fit_ctx *ctx)
+{
+    return ctx->interrupted && ctx->interrupted(ctx->interrupt_arg);
+}
 
 /* What `tcbench run --dry-run` knows of a cell before running it. */
 typedef struct tcb_cost_query {

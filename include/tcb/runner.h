@@ -26,6 +26,11 @@ typedef struct tcb_run_opts {
     tcb_reporter reporter;
     const unsigned char *cells; /* [tcb_grid_count] 1: run cell id k; NULL: every cell */
     double lock_timeout_s;   /* a cell lock whose heartbeat is older is taken over; 0: 600 s */
+    /* May be NULL. Nonzero: stop (a fit saves its state, the cell in hand is
+     * released unwritten, no further cell starts) and return
+     * TCB_ERR_INTERRUPTED. */
+    int (*interrupted)(const void *arg);
+    const void *interrupt_arg;
 } tcb_run_opts;
 
 #define TCB_LOCK_TIMEOUT_DEFAULT_S 600.0
@@ -58,6 +63,11 @@ int tcb_run_dry(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_
 /* `tcbench cells`: every cell of the config, in id order, with its state in
  * the run directory (done, failed, diverged, missing). */
 int tcb_run_list_cells(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_error *err);
+
+/* `tcbench status`: the running cells (host, pid, heartbeat age), the failed
+ * ones with their messages, the count per state, and the missing ids as a
+ * Slurm --array list ("0-3,7"). */
+int tcb_run_status(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_error *err);
 
 #ifdef __cplusplus
 }

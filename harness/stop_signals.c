@@ -1,0 +1,57 @@
+/* SIGTERM and SIGUSR1 as a request to stop cleanly (Slurm sends SIGTERM
+ * before it preempts or cancels a job, and `--signal=USR1@120` ahead of the
+ * time limit): the signals are blocked in every thread and one thread waits
+ * for them with sigwait, so the request is an ordinary atomic flag the run
+ * polls at its safe points, and no handler runs in the middle of a
+ * training step. */
+#include <pthread.h>
+#include <signal.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "harness/internal.h"
+
+static void *wait_for_signal(void *arg)
+{
+    tcb_stop_signals *s = arg;
+    for (;;) {
+        int sig = 0;
+        if (sigwait(&s->set, &sig)) continue;
+        if (atomic_load(&s->closing)) return NULL;
+        atomic_store(&s->signal, sig);
+        fprintf(stderr, "tcbench: %s received: stopping at the next safe point and saving the state\n",
+                sig == SIGTERM ? "SIGTERM" : "SIGUSR1");
+    }
+}
+
+int tcb_stop_signals_start(tcb_stop_signals *s)
+{
+    memset(s, 0, sizeof *s);
+    sigemptyset(&s->set);
+    sigaddset(&s->set, SIGTERM);
+    sigaddset(&s->set, SIGUSR1);
+    /* Threads created later (OpenMP's, the lock heartbeats) inherit the mask. */
+    if (pthread_sigmask(SIG_BLOCK, &s->set, &s->old)) return -1;
+    if (pthread_create(&s->thread, NULL, wait_for_signal, s)) {
+        pthread_sigmask(SIG_SETMASK, &s->old, NULL);
+        return -1;
+    }
+    s->started = 1;
+    return 0;
+}
+
+int tcb_stop_signals_requested(const void *arg)
+{
+    const tcb_stop_signals *s = arg;
+    return atomic_load(&((tcb_stop_signals *)s)->signal);
+}
+
+void tcb_stop_signals_end(tcb_stop_signals *s)
+{
+    if (!s->started) return;
+    atomic_store(&s->closing, 1);
+    pthread_kill(s->thread, SIGUSR1);
+    pthread_join(s->thread, NULL);
+    pthread_sigmask(SIG_SETMASK, &s->old, NULL);
+    s->started = 0;
+}

@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# Preemption (Slurm's SIGTERM, or --signal=USR1): a run asked to stop saves
+# its training at the next iteration (without periodic checkpoints too),
+# releases the cell, leaves no result for it and exits 75; the rerun resumes
+# and ends with the cell of an uninterrupted run, bit for bit. A stop during
+# an evaluation keeps the fitted model and only redoes the evaluation.
+set -euo pipefail
+: "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
+source "$TCB_SOURCE_DIR/tests/integration/cells.sh"
+
+tmp=$(mktemp -d)
+pid=""
+trap '[ -n "$pid" ] && kill -9 "$pid" 2>/dev/null; rm -rf "$tmp"' EXIT
+cd "$tmp"
+
+cat > train.json <<'JSON'
+{ "name": "train", "splits_dir": "splits", "cache_dir": "", "seeds": [0], "threads": 1,
+  "evaluation": { "pairs": 20, "pool_size": 1000, "input_points": 300 },
+  "datasets": [ { "name": "synth", "source": "synthetic", "frames": 6,
+                  "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
+  "methods": [ { "name": "mca", "params": { "preset": "tiny", "iterations": 400, "checkpoint_every": 0 } } ] }
+JSON
+work=work/synth/quadruped_walk/mca/seed_0
+cell=cells/synth/quadruped_walk/mca/seed_0.json
+"$TCBENCH" run train.json --out full --quiet
+
+# stop_when SIGNAL LOG TEXT: signal the run once LOG shows TEXT; its exit status.
+stop_when() {
+    local sig=$1 log=$2 text=$3 rc=0
+    for _ in $(seq 3000); do grep -qF -- "$text" "$log" 2>/dev/null && break; sleep 0.02; done
+    kill "-$sig" "$pid"
+    wait "$pid" || rc=$?
+    pid=""
+    return "$rc"
+}
+
+# During the training: SIGTERM.
+CI= "$TCBENCH" run train.json --out stopped 2> term.log &
+pid=$!
+rc=0; stop_when TERM term.log "mca: " || rc=$?
+[ "$rc" -eq 75 ] || { echo "FAIL: exit $rc after SIGTERM, expected 75"; cat term.log; exit 1; }
+grep -q "stopped at iteration [0-9]* of 400; training state saved in .*train.ckpt" term.log || { cat term.log; exit 1; }
+[ -s "stopped/$work/train.ckpt" ] && [ ! -e "stopped/$cell" ] && [ -z "$(find stopped -name '*.lock')" ] ||
+    { echo "FAIL: expected a training state, no cell and no lock"; find stopped; exit 1; }
+CI= "$TCBENCH" run train.json --out stopped 2> resume.log
+grep -q "resuming training at iteration [1-9]" resume.log || { echo "FAIL: did not resume"; cat resume.log; exit 1; }
+same_cells full stopped
+
+# During the evaluation: SIGUSR1; the model checkpoint is reused, not refitted.
+rm "stopped/$cell"
+CI= "$TCBENCH" run train.json --out stopped 2> usr1.log &
+pid=$!
+rc=0; stop_when USR1 usr1.log "seed 0: " || rc=$?
+[ "$rc" -eq 75 ] && grep -qF "of the evaluation (the fitted model is kept)" usr1.log || { echo "FAIL: exit $rc"; cat usr1.log; exit 1; }
+CI= "$TCBENCH" run train.json --out stopped 2> again.log
+grep -q "resuming training" again.log && { echo "FAIL: the fitted model was not kept"; cat again.log; exit 1; }
+same_cells full stopped
+echo "preemption test passed"

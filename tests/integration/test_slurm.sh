@@ -1,0 +1,107 @@
+#!/usr/bin/env bash
+# On a real Slurm: a one-node cluster on this machine (munged, slurmctld and
+# slurmd started here with a config written to a temporary directory, two
+# CPUs), scripts/slurm/submit.sh runs a small grid as a job array and the
+# cells equal a plain local run bit for bit; a training task told to stop
+# (USR1 to its batch shell, as --signal=B:USR1@120 does) saves its state,
+# exits 75, requeues itself and ends with the uninterrupted cell. Needs root
+# and Debian's slurm-wlm and munge (scripts/setup.sh --tests installs them);
+# skips loudly otherwise. The daemons are stopped whatever happens.
+set -euo pipefail
+: "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
+source "$TCB_SOURCE_DIR/tests/integration/cells.sh"
+skip() { echo "SKIP: $*"; exit 77; }
+[ "$(id -u)" -eq 0 ] || skip "needs root to start slurmd and munged"
+for b in munged slurmctld slurmd sbatch scontrol squeue sinfo runuser; do
+    command -v "$b" > /dev/null || skip "$b not found (scripts/setup.sh --tests installs slurm-wlm and munge)"
+done
+[ -r /etc/munge/munge.key ] || skip "no /etc/munge/munge.key (the munge package makes it)"
+
+tmp=$(mktemp -d)
+chmod 755 "$tmp"
+stop_daemons() {
+    for f in "$tmp/slurmd.pid" "$tmp/slurmctld.pid" "$tmp/munge/pid"; do
+        [ -s "$f" ] && kill "$(cat "$f")" 2> /dev/null || true
+    done
+    sleep 1
+    for f in "$tmp/slurmd.pid" "$tmp/slurmctld.pid" "$tmp/munge/pid"; do
+        [ -s "$f" ] && kill -9 "$(cat "$f")" 2> /dev/null || true
+    done
+}
+trap 'stop_daemons; rm -rf "$tmp"' EXIT
+cd "$tmp"
+
+mkdir -p munge state spool
+chown munge:munge munge && chmod 755 munge
+runuser -u munge -- munged --socket="$tmp/munge/sock" --pid-file="$tmp/munge/pid" --log-file="$tmp/munge/log" \
+    --seed-file="$tmp/munge/seed" || skip "munged did not start: $(cat munge/log 2> /dev/null)"
+host=$(hostname -s)
+port=$((20000 + RANDOM % 20000))
+cat > slurm.conf <<CONF
+ClusterName=tcbtest
+SlurmctldHost=$host
+SlurmUser=root
+SlurmdUser=root
+SlurmctldPort=$port
+SlurmdPort=$((port + 1))
+AuthType=auth/munge
+AuthInfo=socket=$tmp/munge/sock
+CredType=cred/munge
+StateSaveLocation=$tmp/state
+SlurmdSpoolDir=$tmp/spool
+SlurmctldPidFile=$tmp/slurmctld.pid
+SlurmdPidFile=$tmp/slurmd.pid
+SlurmctldLogFile=$tmp/slurmctld.log
+SlurmdLogFile=$tmp/slurmd.log
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+SelectType=select/cons_tres
+SelectTypeParameters=CR_CPU
+JobAcctGatherType=jobacct_gather/none
+AccountingStorageType=accounting_storage/none
+MpiDefault=none
+ReturnToService=2
+SchedulerParameters=defer
+NodeName=$host CPUs=2 State=UNKNOWN
+PartitionName=test Nodes=ALL Default=YES MaxTime=INFINITE State=UP
+CONF
+export SLURM_CONF="$tmp/slurm.conf"
+slurmctld -f "$SLURM_CONF" || skip "slurmctld did not start: $(tail -3 slurmctld.log 2> /dev/null)"
+slurmd -f "$SLURM_CONF" || skip "slurmd did not start: $(tail -3 slurmd.log 2> /dev/null)"
+for _ in $(seq 100); do sinfo -h -o %t 2> /dev/null | grep -q idle && break; sleep 0.2; done
+sinfo -h -o %t | grep -q idle || skip "the node did not come up: $(tail -3 slurmd.log)"
+
+# A grid of four cells, submitted as an array of one-CPU tasks.
+cat > grid.json <<'JSON'
+{ "name": "grid", "splits_dir": "splits", "cache_dir": "", "seeds": [0, 1], "threads": 1,
+  "evaluation": { "pairs": 5, "pool_size": 1000, "input_points": 300 },
+  "datasets": [ { "name": "synth", "source": "synthetic", "frames": 6,
+                  "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
+  "methods": [ { "name": "nearest" },
+               { "name": "mca", "params": { "preset": "tiny", "iterations": 100, "checkpoint_every": 0 } } ] }
+JSON
+"$TCBENCH" run grid.json --out plain --quiet 2> /dev/null
+TCBENCH="$TCBENCH" "$TCB_SOURCE_DIR/scripts/slurm/submit.sh" grid.json --out "$tmp/slurm" \
+    --sbatch "--wait -c 1 -o $tmp/task-%a.log" > submit.txt 2>&1 || { cat submit.txt task-*.log slurmctld.log; exit 1; }
+same_cells plain slurm
+
+# Preemption: USR1 to the batch shell mid-training; the task requeues itself.
+sed 's/"iterations": 100/"iterations": 1500/; s/"seeds": \[0, 1\]/"seeds": [0]/' grid.json > long.json
+"$TCBENCH" run long.json --out plain-long --quiet 2> /dev/null
+TCBENCH="$TCBENCH" "$TCB_SOURCE_DIR/scripts/slurm/submit.sh" long.json --out "$tmp/long" \
+    --sbatch "-c 1 -o $tmp/long-%a.log" > submit-long.txt 2>&1 || { cat submit-long.txt; exit 1; }
+job=$(sed -n 's/^Submitted batch job \([0-9]*\)$/\1/p' submit-long.txt)
+train=long/work/synth/quadruped_walk/mca/seed_0
+lock=long/cells/synth/quadruped_walk/mca/seed_0.json.lock
+for _ in $(seq 600); do [ -e "$lock" ] && break; sleep 0.1; done
+sleep 2 # into the training
+scancel --batch --signal=USR1 "${job}_1" || { echo "FAIL: could not signal the task"; cat long-1.log; exit 1; }
+for _ in $(seq 1200); do
+    [ -s long/cells/synth/quadruped_walk/mca/seed_0.json ] && [ -z "$(squeue -h -j "$job" 2> /dev/null)" ] && break
+    sleep 0.2
+done
+grep -q "stopped at iteration [1-9][0-9]* of 1500; training state saved" long-1.log &&
+    grep -qF "stopped with its state saved; requeueing" long-1.log || { echo "FAIL: no requeue"; cat long-1.log; exit 1; }
+[ ! -e "$train/train.ckpt" ] || { echo "FAIL: training state left"; exit 1; }
+same_cells plain-long long
+echo "slurm test passed"
