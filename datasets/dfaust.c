@@ -347,11 +347,14 @@ static int read_subjects(const dfaust_files *f, const char *sequence, dfaust_sub
     return rc;
 }
 
-/* The subjects of the request: listed (in their order) or found (sorted). */
-static int select_subjects(const dfaust_files *f, const char *sequence, char *const *subjects, int n_subjects,
-                           dfaust_subject **list, int *n, tcb_error *err)
+/* The files of root and the subjects of the request, listed (in their
+ * order) or found (sorted); the caller frees *list and closes f. */
+static int open_subjects(const char *root, const char *sequence, char *const *subjects, int n_subjects,
+                         dfaust_files *f, dfaust_subject **list, int *n, tcb_error *err)
 {
     *list = NULL, *n = n_subjects;
+    int rc = open_files(root, sequence, f, err);
+    if (rc) return rc;
     if (!n_subjects) return find_all(f, sequence, list, n, err);
     if (!(*list = calloc((size_t)n_subjects, sizeof **list)))
         return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", sequence);
@@ -365,10 +368,8 @@ int tcb_dfaust_read(const char *root, const char *sequence, char *const *subject
     tcb_h5_quiet q;
     tcb_h5_quiet_begin(&q);
     dfaust_files f;
-    dfaust_subject *list = NULL;
-    int n = 0;
-    int rc = open_files(root, sequence, &f, err);
-    if (!rc) rc = select_subjects(&f, sequence, subjects, n_subjects, &list, &n, err);
+    dfaust_subject *list;
+    int n, rc = open_subjects(root, sequence, subjects, n_subjects, &f, &list, &n, err);
     if (!rc) rc = read_subjects(&f, sequence, list, n, out, err);
     free(list);
     close_files(&f);
@@ -383,10 +384,8 @@ int tcb_dfaust_probe(const char *root, const char *sequence, char *const *subjec
     tcb_h5_quiet q;
     tcb_h5_quiet_begin(&q);
     dfaust_files f;
-    dfaust_subject *list = NULL;
-    int n = 0;
-    int rc = open_files(root, sequence, &f, err);
-    if (!rc) rc = select_subjects(&f, sequence, subjects, n_subjects, &list, &n, err);
+    dfaust_subject *list;
+    int n, rc = open_subjects(root, sequence, subjects, n_subjects, &f, &list, &n, err);
     if (!rc) rc = measure_subjects(&f, sequence, list, n, n_verts, n_frames, err);
     free(list);
     close_files(&f);

@@ -34,6 +34,18 @@ static void ratio_text(const tcb_ref_cmp_row *row, int m, char *out, size_t size
     else snprintf(out, size, "-");
 }
 
+/* A value's three texts: ours, the paper's, ours/paper; pm joins mean and std. */
+typedef struct value_texts {
+    char ours[96], paper[96], ratio[32];
+} value_texts;
+
+static void value_texts_of(const tcb_ref_cmp_row *row, int m, const char *pm, value_texts *t)
+{
+    ours_text(row, m, pm, t->ours, sizeof t->ours);
+    paper_text(row->paper, m, pm, t->paper, sizeof t->paper);
+    ratio_text(row, m, t->ratio, sizeof t->ratio);
+}
+
 /* "m_sL2: same order (3 pairs)" or "rank: 1 of 3 pairs flipped, e.g. ..." */
 static void ordering_text(const tcb_ref_group *g, int m, char *out, size_t size)
 {
@@ -62,12 +74,10 @@ static void md_group(FILE *f, const tcb_ref_cmp_table *t, const tcb_ref_group *g
         const tcb_ref_cmp_row *row = &g->rows[k];
         fprintf(f, "| %s | %s |", row->paper->paper_row, row->paper->method);
         for (int m = 0; m < TCB_N_METRICS; m++) {
+            value_texts v;
             if (!t->shown[m]) continue;
-            char o[96], p[96], q[32];
-            ours_text(row, m, " ± ", o, sizeof o);
-            paper_text(row->paper, m, " ± ", p, sizeof p);
-            ratio_text(row, m, q, sizeof q);
-            fprintf(f, " %s | %s | %s |", o, p, q);
+            value_texts_of(row, m, " ± ", &v);
+            fprintf(f, " %s | %s | %s |", v.ours, v.paper, v.ratio);
         }
         fprintf(f, "\n");
     }
@@ -114,12 +124,10 @@ static void tex_group(FILE *f, const tcb_ref_cmp_table *t, const tcb_ref_group *
         const tcb_ref_cmp_row *row = &g->rows[k];
         tcb_rpt_tex_escaped(f, row->paper->paper_row);
         for (int m = 0; m < TCB_N_METRICS; m++) {
+            value_texts v;
             if (!t->shown[m]) continue;
-            char o[96], p[96], q[32];
-            ours_text(row, m, " $\\pm$ ", o, sizeof o);
-            paper_text(row->paper, m, " $\\pm$ ", p, sizeof p);
-            ratio_text(row, m, q, sizeof q);
-            fprintf(f, " & %s / %s (%s)", o, p, q);
+            value_texts_of(row, m, " $\\pm$ ", &v);
+            fprintf(f, " & %s / %s (%s)", v.ours, v.paper, v.ratio);
         }
         fputs(" \\\\\n", f);
     }
