@@ -42,7 +42,8 @@ static void *heartbeat(void *arg)
     return NULL;
 }
 
-int tcb_cell_lock_read(const char *path, tcb_lock_info *info)
+/* The lock file at `path`: 0, or -1 when there is none. */
+static int read_lock(const char *path, tcb_lock_info *info)
 {
     memset(info, 0, sizeof *info);
     struct stat st;
@@ -80,6 +81,18 @@ static const char *stale_reason(const tcb_lock_info *h, double timeout_s)
     return NULL;
 }
 
+static int lock_path(char *out, size_t size, const char *cell_path, tcb_error *err)
+{
+    return tcb_path_join(out, size, err, "%s.lock", cell_path);
+}
+
+int tcb_cell_lock_holder(const char *cell_path, tcb_lock_info *info)
+{
+    char path[TCB_PATH_MAX];
+    tcb_error err = {0};
+    return lock_path(path, sizeof path, cell_path, &err) ? -1 : read_lock(path, info);
+}
+
 static int write_lock_temp(const char *path, char *tmp, size_t size, tcb_error *err)
 {
     char host[256] = "";
@@ -111,7 +124,7 @@ static int take_over(const char *path, const char *tmp, const tcb_lock_info *old
         return 0;
     }
     tcb_lock_info now;
-    int same = !tcb_cell_lock_read(path, &now) && now.pid == old->pid && now.started == old->started &&
+    int same = !read_lock(path, &now) && now.pid == old->pid && now.started == old->started &&
                !strcmp(now.host, old->host);
     int taken = same && !unlink(path) && !link(tmp, path);
     unlink(guard);
@@ -126,13 +139,13 @@ int tcb_cell_lock_acquire(tcb_cell_lock *l, const char *cell_path, double timeou
     note[0] = '\0';
     l->timeout_s = timeout_s;
     char tmp[TCB_PATH_MAX];
-    int rc = tcb_path_join(l->path, sizeof l->path, err, "%s.lock", cell_path);
+    int rc = lock_path(l->path, sizeof l->path, cell_path, err);
     if (!rc) rc = write_lock_temp(l->path, tmp, sizeof tmp, err);
     if (rc) return rc;
     int claimed = !link(tmp, l->path);
     if (!claimed && errno != EEXIST) {
         rc = tcb_fail(err, TCB_ERR_IO, "%s: cannot create the lock: %s", l->path, strerror(errno));
-    } else if (!claimed && !tcb_cell_lock_read(l->path, holder)) {
+    } else if (!claimed && !read_lock(l->path, holder)) {
         const char *why = stale_reason(holder, timeout_s);
         if (why && (claimed = take_over(l->path, tmp, holder)))
             snprintf(note, note_size, "took over the lock of %s pid %ld: %s (heartbeat %.0f s old)", holder->host,

@@ -79,8 +79,8 @@ int tcb_cell_lock_acquire(tcb_cell_lock *l, const char *cell_path, double timeou
                           char *note, size_t note_size, tcb_error *err);
 /* Stops the heartbeat and removes the lock; nothing when not held. */
 void tcb_cell_lock_release(tcb_cell_lock *l);
-/* The lock file at `path` (<cell>.json.lock): 0, or -1 when there is none. */
-int tcb_cell_lock_read(const char *path, tcb_lock_info *info);
+/* The holder of the cell at cell_path: 0, or -1 when it has no lock. */
+int tcb_cell_lock_holder(const char *cell_path, tcb_lock_info *info);
 
 /* SIGTERM / SIGUSR1 as a stop request (harness/stop_signals.c): start
  * blocks them in the calling thread (call it before any other thread

@@ -62,14 +62,13 @@ static void cell_state_message(const char *run_dir, const tcb_dataset_spec *d, c
                                const tcb_method_spec *m, int seed, char *out, size_t size, char *msg, size_t msg_size)
 {
     if (msg) msg[0] = '\0';
-    char path[TCB_PATH_MAX], lock[TCB_PATH_MAX + 8];
+    char path[TCB_PATH_MAX];
     tcb_error err = {0};
     snprintf(out, size, "missing");
     if (tcb_cell_path(path, sizeof path, run_dir, d->name, seq, m->label, seed, &err)) return;
     tcb_lock_info h;
-    snprintf(lock, sizeof lock, "%s.lock", path);
     if (!tcb_is_file(path)) {
-        if (!tcb_cell_lock_read(lock, &h))
+        if (!tcb_cell_lock_holder(path, &h))
             snprintf(out, size, "running (%s pid %ld, heartbeat %.0f s ago)", h.host, h.pid, h.heartbeat_age_s);
         return;
     }

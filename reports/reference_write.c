@@ -176,12 +176,13 @@ static void write_csv(FILE *f, const tcb_ref_cmp *c)
 
 /* The tables the run's config says it reproduces of reference `name`
  * (<run>/config.json "reference"); 0 when it names none of it. */
-static int config_tables(const char *run_dir, const char *name, char (*ids)[16], tcb_error *err)
+static int config_tables(const char *run_dir, const char *name, char (*ids)[16])
 {
     char path[TCB_PATH_MAX];
     cJSON *cfg = NULL;
-    if (tcb_path_join(path, sizeof path, err, "%s/config.json", run_dir) || !tcb_is_file(path) ||
-        tcb_json_load(path, &cfg, err))
+    tcb_error err = {0};
+    if (tcb_path_join(path, sizeof path, &err, "%s/config.json", run_dir) || !tcb_is_file(path) ||
+        tcb_json_load(path, &cfg, &err))
         return 0; /* a run without its config: every table naming its cells */
     const cJSON *ref = cJSON_GetObjectItemCaseSensitive(cfg, "reference");
     const cJSON *src = cJSON_GetObjectItemCaseSensitive(ref, "source");
@@ -221,7 +222,7 @@ int tcb_report_reference(const char *run_dir, const char *reference, const char 
         return rc;
     }
     tcb_ref_cmp c = {0};
-    int n_ids = config_tables(run_dir, ref.name, ids, err);
+    int n_ids = config_tables(run_dir, ref.name, ids);
     rc = tcb_ref_compare(&ref, &r, (const char(*)[16])ids, n_ids, &c, err);
     if (!rc) rc = tcb_mkdirs(dir, err);
     if (!rc) rc = write_one(dir, ref.name, "md", write_md, &c, err);
