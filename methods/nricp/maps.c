@@ -9,10 +9,12 @@
  * between the last frame of a block and the first of the next are not
  * registered: they stay the identity, which keeps the layout and the
  * checkpoint's checks (a permutation) as they are. */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "methods/nricp/nricp_internal.h"
+#include "tcb/fsutil.h"
 #include "tcb/lap.h"
 #include "tcb/nn.h"
 
@@ -61,30 +63,108 @@ static int one_map(const nricp_method *m, const tcb_sequence *seq, int a, int b,
     return rc;
 }
 
+/* The state of an unfinished fit in the cell's work directory. */
+#define PARTIAL_NAME "nricp_maps.partial"
+/* Seconds between two saves of an unfinished fit (besides the one a stop
+ * request makes): a registration of crane takes 1-16 s, its state 14 MB. */
+#define SAVE_EVERY_S 60.0
+
+typedef struct fit_state {
+    unsigned char *done;  /* [jobs] 1 once that row of the maps is computed */
+    int n_done, jobs;
+    double earlier_s;     /* what the processes before this one spent */
+    double start_s, saved_s;
+    char path[TCB_PATH_MAX]; /* "" without a work directory */
+} fit_state;
+
+/* Job t's map: t = 2k registers frame k onto k+1, t = 2k+1 frame k+1 onto k. */
+static void job_frames(int t, int *a, int *b)
+{
+    int k = t / 2;
+    *a = t % 2 ? k + 1 : k, *b = t % 2 ? k : k + 1;
+}
+
+static int save_state(const nricp_method *m, fit_state *st, tcb_error *err)
+{
+    st->saved_s = tcb_now_seconds();
+    return nricp_write_state(m, st->done, st->earlier_s + st->saved_s - st->start_s, st->path, err);
+}
+
+/* Continues an unfinished fit from the work directory when it has one
+ * written for this method and sequence; warns and starts afresh otherwise. */
+static void resume(nricp_method *m, const tcb_fit_ctx *ctx, fit_state *st)
+{
+    if (!st->path[0] || !tcb_is_file(st->path)) return;
+    tcb_error e = {0};
+    if (nricp_read_state(m, st->done, &st->earlier_s, st->path, &e)) {
+        memset(st->done, 0, (size_t)st->jobs);
+        st->earlier_s = 0;
+        tcb_report_log(&ctx->reporter, TCB_LOG_WARN, "nricp: not resumed (%s); registering every map again",
+                       e.msg);
+        return;
+    }
+    for (int t = 0; t < st->jobs; t++) st->n_done += st->done[t];
+    tcb_report_log(&ctx->reporter, TCB_LOG_INFO, "nricp: resuming the consecutive maps with %d of %d done from %s (%.0f s in)",
+                   st->n_done, st->jobs, st->path, st->earlier_s);
+}
+
+/* Marks a row of the maps done; saves the state when the last save is a
+ * minute old. Called inside the critical section of the fit's loop. */
+static void finish_map(const nricp_method *m, const tcb_fit_ctx *ctx, fit_state *st, size_t row, tcb_error *err)
+{
+    st->done[row] = 1;
+    tcb_report_progress(&ctx->reporter, ++st->n_done, st->jobs, "nricp: consecutive maps");
+    if (st->path[0] && st->n_done < st->jobs && tcb_now_seconds() - st->saved_s >= SAVE_EVERY_S)
+        save_state(m, st, err);
+}
+
+static int compute_maps(nricp_method *m, const tcb_sequence *seq, const tcb_fit_ctx *ctx, fit_state *st,
+                        tcb_error *errs)
+{
+    int threads = ctx->n_threads > 0 ? ctx->n_threads : 1;
+    /* Each registration is deterministic and writes only its own row, so
+     * the maps depend neither on the thread count, nor on the schedule, nor
+     * on where an earlier process stopped. A stop request lets the maps in
+     * progress finish and starts no other. */
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int t = 0; t < st->jobs; t++) {
+        int a, b;
+        job_frames(t, &a, &b);
+        size_t row = nricp_map_row(m, a, b);
+        if (st->done[row] || tcb_fit_interrupted(ctx)) continue;
+        if (one_map(m, seq, a, b, m->maps + nricp_map_at(m, a, b), &errs[t])) continue;
+#pragma omp critical(nricp_progress)
+        finish_map(m, ctx, st, row, &errs[t]);
+    }
+    for (int t = 0; t < st->jobs; t++)
+        if (errs[t].code) return t;
+    return -1;
+}
+
 int nricp_fit_maps(nricp_method *m, const tcb_sequence *seq, const tcb_fit_ctx *ctx,
                    tcb_error *err)
 {
-    int steps = m->n_frames - 1, jobs = 2 * steps;
+    fit_state st = {.jobs = 2 * (m->n_frames - 1), .start_s = tcb_now_seconds()};
+    st.saved_s = st.start_s;
     free(m->maps);
-    m->maps = malloc(nricp_maps_len(m) * sizeof *m->maps);
-    tcb_error *errs = calloc((size_t)jobs, sizeof *errs);
-    if (!m->maps || !errs) {
-        free(errs);
-        return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory for %d maps", jobs);
+    m->maps = calloc(nricp_maps_len(m), sizeof *m->maps);
+    st.done = calloc((size_t)st.jobs, 1);
+    tcb_error *errs = calloc((size_t)st.jobs, sizeof *errs);
+    int rc = !m->maps || !st.done || !errs ? tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory for %d maps", st.jobs)
+                                           : TCB_OK;
+    if (!rc && ctx->work_dir) rc = tcb_path_join(st.path, sizeof st.path, err, "%s/%s", ctx->work_dir, PARTIAL_NAME);
+    if (!rc) resume(m, ctx, &st);
+    int failed = rc ? -1 : compute_maps(m, seq, ctx, &st, errs);
+    if (!rc && failed >= 0) rc = tcb_fail(err, errs[failed].code, "%s", errs[failed].msg);
+    if (!rc && st.n_done < st.jobs) {
+        rc = st.path[0] ? save_state(m, &st, err) : TCB_OK;
+        if (!rc)
+            rc = tcb_fail(err, TCB_ERR_INTERRUPTED, "nricp: stopped after %d of %d consecutive maps%s%s", st.n_done,
+                          st.jobs, st.path[0] ? "; maps saved in " : " (no work directory: nothing saved)", st.path);
     }
-    int threads = ctx->n_threads > 0 ? ctx->n_threads : 1, done = 0;
-    /* Each registration is deterministic and writes only its own row, so
-     * the maps do not depend on the thread count or the schedule. */
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (int t = 0; t < jobs; t++) {
-        int k = t / 2, a = t % 2 ? k + 1 : k, b = t % 2 ? k : k + 1;
-        one_map(m, seq, a, b, m->maps + nricp_map_at(m, a, b), &errs[t]);
-#pragma omp critical(nricp_progress)
-        tcb_report_progress(&ctx->reporter, ++done, jobs, "nricp: consecutive maps");
-    }
-    int rc = TCB_OK;
-    for (int t = 0; t < jobs && !rc; t++)
-        if (errs[t].code) rc = tcb_fail(err, errs[t].code, "%s", errs[t].msg);
+    if (!rc && ctx->resumed_fit_s) *ctx->resumed_fit_s = st.earlier_s;
+    if (!rc && st.path[0]) remove(st.path);
+    free(st.done);
     free(errs);
     return rc;
 }

@@ -40,18 +40,24 @@ static inline size_t nricp_maps_len(const nricp_method *m)
     return 2 * (size_t)(m->n_frames - 1) * (size_t)m->n_verts;
 }
 
-/* Offset in maps of the row mapping frame a to the adjacent frame b = a ± 1. */
+/* The row of maps mapping frame a to the adjacent frame b = a ± 1, and its offset. */
+static inline size_t nricp_map_row(const nricp_method *m, int a, int b)
+{
+    return b > a ? (size_t)a : (size_t)(m->n_frames - 1) + (size_t)b;
+}
+
 static inline size_t nricp_map_at(const nricp_method *m, int a, int b)
 {
-    size_t row = b > a ? (size_t)a : (size_t)(m->n_frames - 1) + (size_t)b;
-    return row * (size_t)m->n_verts;
+    return nricp_map_row(m, a, b) * (size_t)m->n_verts;
 }
 
 /* Sizes and vertex normals of seq (fit and load both start here). */
 int nricp_prepare(nricp_method *m, const tcb_sequence *seq, tcb_error *err);
 
 /* maps.c: compute every consecutive map (OpenMP over the 2(F−1)
- * registrations, progress through ctx->reporter), and compose them. */
+ * registrations, progress through ctx->reporter), and compose them. A stop
+ * request (ctx->interrupted) saves the maps done so far in ctx->work_dir
+ * and returns TCB_ERR_INTERRUPTED; the next fit there continues them. */
 int nricp_fit_maps(nricp_method *m, const tcb_sequence *seq, const tcb_fit_ctx *ctx,
                    tcb_error *err);
 void nricp_compose(const nricp_method *m, int i, int j, int32_t *idx);
@@ -59,6 +65,12 @@ void nricp_compose(const nricp_method *m, int i, int j, int32_t *idx);
 /* checkpoint.c */
 uint64_t nricp_sequence_hash(const tcb_sequence *seq); /* FNV-1a of the vertices and block starts */
 int nricp_save(void *self, const char *path, tcb_error *err);
+/* The maps whose done[r] is 1 (done NULL: all of them) and the seconds
+ * an unfinished fit has cost; read_state fills m->maps, done[2(F−1)] and
+ * *fit_s of a prepared m. */
+int nricp_write_state(const nricp_method *m, const unsigned char *done, double fit_s, const char *path,
+                      tcb_error *err);
+int nricp_read_state(nricp_method *m, unsigned char *done, double *fit_s, const char *path, tcb_error *err);
 int nricp_load(void *self, const tcb_sequence *seq, const char *path, tcb_error *err);
 
 #endif

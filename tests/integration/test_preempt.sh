@@ -3,7 +3,8 @@
 # its training at the next iteration (without periodic checkpoints too),
 # releases the cell, leaves no result for it and exits 75; the rerun resumes
 # and ends with the cell of an uninterrupted run, bit for bit. A stop during
-# an evaluation keeps the fitted model and only redoes the evaluation.
+# an evaluation keeps the fitted model and only redoes the evaluation. An
+# nricp fit stopped mid-way keeps the consecutive maps it has.
 set -euo pipefail
 : "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
 source "$TCB_SOURCE_DIR/tests/integration/cells.sh"
@@ -55,4 +56,29 @@ rc=0; stop_when USR1 usr1.log "seed 0: " || rc=$?
 CI= "$TCBENCH" run train.json --out stopped 2> again.log
 grep -q "resuming training" again.log && { echo "FAIL: the fitted model was not kept"; cat again.log; exit 1; }
 same_cells full stopped
+# nricp's consecutive maps: SIGTERM mid-fit saves the maps done so far;
+# the rerun registers only the others and ends with the same cell.
+cat > maps.json <<'JSON'
+{ "name": "maps", "splits_dir": "maps_splits", "cache_dir": "", "seeds": [0], "threads": 1,
+  "evaluation": { "pairs": 20, "pool_size": 1000, "input_points": 300 },
+  "datasets": [ { "name": "synth", "source": "synthetic", "frames": 24,
+                  "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
+  "methods": [ { "name": "nricp", "params": { "strategy": "propagate_bijective" } } ] }
+JSON
+work=work/synth/quadruped_walk/nricp/seed_0
+cell=cells/synth/quadruped_walk/nricp/seed_0.json
+"$TCBENCH" run maps.json --out maps_full --quiet
+CI= "$TCBENCH" run maps.json --out maps_stopped 2> maps_term.log &
+pid=$!
+rc=0; stop_when TERM maps_term.log "nricp: consecutive maps: " || rc=$?
+[ "$rc" -eq 75 ] || { echo "FAIL: nricp: exit $rc after SIGTERM, expected 75"; cat maps_term.log; exit 1; }
+grep -q "stopped after [1-9][0-9]* of 46 consecutive maps; maps saved in .*nricp_maps.partial" maps_term.log ||
+    { cat maps_term.log; exit 1; }
+[ -s "maps_stopped/$work/nricp_maps.partial" ] && [ ! -e "maps_stopped/$cell" ] ||
+    { echo "FAIL: expected the partial maps and no cell"; find maps_stopped; exit 1; }
+CI= "$TCBENCH" run maps.json --out maps_stopped 2> maps_resume.log
+grep -q "resuming the consecutive maps with [1-9][0-9]* of 46 done" maps_resume.log ||
+    { echo "FAIL: nricp did not resume"; cat maps_resume.log; exit 1; }
+[ ! -e "maps_stopped/$work/nricp_maps.partial" ] || { echo "FAIL: the partial maps were left behind"; exit 1; }
+same_cells maps_full maps_stopped
 echo "preemption test passed"

@@ -621,6 +621,80 @@ static void test_load_rejects_bad_checkpoints(void **state)
     tcb_sequence_free(&other);
 }
 
+/* Asks to stop once `after` maps were started (one thread: exactly so). */
+typedef struct stop_after {
+    int calls, after;
+} stop_after;
+
+static int stop_requested(const void *arg)
+{
+    stop_after *s = (stop_after *)arg; /* the test's own, non-const object */
+    return ++s->calls > s->after;
+}
+
+/* One fit in dir as a cell's fit: work_dir, an optional stop; its code. */
+static int fit_in(void *self, const tcb_sequence *s, const char *dir, stop_after *stop, double *earlier,
+                  progress_log *log, tcb_error *err)
+{
+    tcb_fit_ctx ctx = {.seed = 1, .n_threads = 1, .work_dir = dir, .resumed_fit_s = earlier};
+    ctx.reporter = (tcb_reporter){on_progress, NULL, log};
+    if (stop) ctx.interrupted = stop_requested, ctx.interrupt_arg = stop;
+    return tcb_registry_find("nricp")->fit(self, s, &ctx, err);
+}
+
+/* A fit asked to stop saves the maps it has and continues them in the next
+ * fit, to the same model as an uninterrupted fit; an unfinished state is
+ * no fitted model, and a corrupt one is registered again from nothing. */
+static void test_stopped_fit_resumes(void **state)
+{
+    const char *dir = *state;
+    const tcb_method_ops *ops = tcb_registry_find("nricp");
+    tcb_sequence s;
+    make_blob_sequence(&s, SEQ_FRAMES);
+    char whole[TCB_PATH_MAX], resumed[TCB_PATH_MAX], partial[TCB_PATH_MAX];
+    void *ref = fitted(&s, all_strategies[2], 1, NULL);
+    save_to(ref, dir, "whole.bin", whole);
+    ops->destroy(ref);
+    snprintf(partial, sizeof partial, "%s/nricp_maps.partial", dir);
+
+    for (int corrupt = 0; corrupt < 2; corrupt++) {
+        void *self;
+        tcb_error err;
+        double earlier = -1;
+        assert_int_equal(ops->create(all_strategies[2], &self, &err), TCB_OK);
+        stop_after stop = {0, 3};
+        progress_log first = {0}, second = {0};
+        assert_int_equal(fit_in(self, &s, dir, &stop, &earlier, &first, &err), TCB_ERR_INTERRUPTED);
+        assert_int_equal(first.calls, 3);
+        if (!strstr(err.msg, "stopped after 3 of") || !strstr(err.msg, partial)) fail_msg("%s", err.msg);
+        assert_true(tcb_is_file(partial));
+        expect_load_error(all_strategies[2], &s, partial, "unfinished fit (3 of");
+        if (corrupt) {
+            char *buf;
+            size_t len;
+            assert_int_equal(tcb_read_file(partial, &buf, &len, &err), TCB_OK);
+            buf[56] = 7; /* the first done flag, after the 56-byte header */
+            assert_int_equal(tcb_write_file_atomic(partial, buf, len, &err), TCB_OK);
+            free(buf);
+        }
+        if (fit_in(self, &s, dir, NULL, &earlier, &second, &err)) fail_msg("resume: %s", err.msg);
+        /* Resumed: only the maps still missing are registered. */
+        assert_int_equal(second.calls, 2 * (SEQ_FRAMES - 1) - (corrupt ? 0 : 3));
+        assert_true(corrupt ? earlier == 0 : earlier >= 0);
+        assert_false(tcb_is_file(partial));
+        save_to(self, dir, "resumed.bin", resumed);
+        char *a, *b;
+        size_t la, lb;
+        assert_int_equal(tcb_read_file(whole, &a, &la, &err), TCB_OK);
+        assert_int_equal(tcb_read_file(resumed, &b, &lb, &err), TCB_OK);
+        assert_int_equal(la, lb);
+        assert_memory_equal(a, b, la);
+        free(a), free(b);
+        ops->destroy(self);
+    }
+    tcb_sequence_free(&s);
+}
+
 static void test_bad_params_rejected(void **state)
 {
     (void)state;
@@ -753,6 +827,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_save_load_round_trip, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test_setup_teardown(test_load_rejects_bad_checkpoints, tu_setup_tmpdir,
                                         tu_teardown_tmpdir),
+        cmocka_unit_test_setup_teardown(test_stopped_fit_resumes, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test(test_bad_params_rejected),
         cmocka_unit_test(test_input_shapes_checked),
         cmocka_unit_test_setup_teardown(test_blocks, tu_setup_tmpdir, tu_teardown_tmpdir),
