@@ -48,14 +48,13 @@ struct tcb_nn {
     flann_index_t index;
 };
 
-/* Coordinates beyond ±1e18 could overflow a squared distance (FLT_MAX ≈ 3e38),
- * after which "nearest" means nothing and FLANN would return no neighbour. */
-#define COORD_MAX 1e18f
-
+/* Coordinates beyond ±TCB_NN_COORD_MAX could overflow a squared distance
+ * (FLT_MAX ≈ 3e38), after which "nearest" means nothing and FLANN would
+ * return no neighbour. */
 static int check_coords(const float *p, int n, const char *what, tcb_error *err)
 {
     for (int i = 0; i < 3 * n; i++)
-        if (!(fabsf(p[i]) <= COORD_MAX)) /* also catches NaN */
+        if (!(fabsf(p[i]) <= TCB_NN_COORD_MAX)) /* also catches NaN */
             return tcb_fail(err, TCB_ERR_NUMERIC, "nn: %s %d is not finite or beyond ±1e18",
                             what, i / 3);
     return TCB_OK;

@@ -32,7 +32,7 @@ void tcb_cell_label(char *out, size_t size, const char *dataset, const char *seq
     snprintf(out, size, "%s/%s/%s/seed %d", dataset, sequence, method, seed);
 }
 
-static int fill_identity(const tcb_cell_job *job, tcb_cell_result *c, tcb_error *herr)
+int tcb_cell_identity(const tcb_cell_job *job, tcb_cell_result *c, tcb_error *herr)
 {
     snprintf(c->dataset, sizeof c->dataset, "%s", job->dataset->name);
     snprintf(c->sequence, sizeof c->sequence, "%s", job->seq->name);
@@ -175,6 +175,21 @@ static void reconstruction_cd(const tcb_cell_job *job, void *self, int i, int j,
     free(pts);
 }
 
+int tcb_cell_score_pair(const tcb_sequence *seq, const tcb_pair_prediction *p, tcb_pair_record *rec,
+                        tcb_summary *sum, tcb_pair_metrics *pm, tcb_error *err)
+{
+    const float *verts_j = tcb_seq_frame(seq, p->j);
+    int nv = seq->n_verts;
+    tcb_pair_metrics m;
+    int rc = p->moved ? tcb_project_to_vertices(verts_j, nv, p->moved, nv, p->pred, err) : TCB_OK;
+    if (!rc) rc = tcb_pair_metrics_compute(verts_j, nv, p->pred, &m, err);
+    if (rc) return rc;
+    *rec = (tcb_pair_record){p->i, p->j, m.sl2, m.sl2sq, m.rank, m.auc, p->cd};
+    tcb_summary_add_pair(sum, &m, p->cd);
+    if (pm) *pm = m;
+    return TCB_OK;
+}
+
 /* Pair k of the split into rec and the summary; with `cap`, its metrics
  * and reconstructions are kept there too. Failures land in merr (the
  * method's) or herr (the harness's); the caller checks both. */
@@ -201,11 +216,6 @@ static void eval_pair(const tcb_cell_job *job, void *self, int k, eval_bufs *b,
                  i, j, k);
         return;
     }
-    const float *verts_j = tcb_seq_frame(seq, j);
-    tcb_pair_metrics pm;
-    if (tcb_project_to_vertices(verts_j, nv, b->moved, nv, b->pred, herr) ||
-        tcb_pair_metrics_compute(verts_j, nv, b->pred, &pm, herr))
-        return;
     double cd = NAN;
     if (job->ops->reconstruct) {
         double cd_i = 0, cd_j = 0;
@@ -217,8 +227,11 @@ static void eval_pair(const tcb_cell_job *job, void *self, int k, eval_bufs *b,
         if (merr->code || herr->code) return;
         cd = 0.5 * (cd_i + cd_j);
     }
-    *rec = (tcb_pair_record){i, j, pm.sl2, pm.sl2sq, pm.rank, pm.auc, cd};
-    tcb_summary_add_pair(sum, &pm, cd);
+    /* Scored last, on the path scored cells take too; the metrics draw no
+     * random numbers, so scoring after the reconstructions changes nothing. */
+    tcb_pair_prediction pred = {i, j, b->moved, b->pred, cd};
+    tcb_pair_metrics pm;
+    if (tcb_cell_score_pair(seq, &pred, rec, sum, &pm, herr)) return;
     if (cap) cap->i = i, cap->j = j, cap->metrics = pm;
 }
 
@@ -285,7 +298,7 @@ static int run_cell(const tcb_cell_job *job, tcb_cell_result *out, tcb_error *er
         if (job->split->pairs[k] < 0 || job->split->pairs[k] >= job->seq->n_frames)
             return tcb_fail(err, TCB_ERR_INPUT, "%s: pair %d names frame %d of %d", job->split_path,
                             k / 2, job->split->pairs[k], job->seq->n_frames);
-    if (fill_identity(job, out, &herr)) goto fail;
+    if (tcb_cell_identity(job, out, &herr)) goto fail;
 
     void *self;
     int prepared = prepare_method(job, &self, &out->fit_s, &merr) == TCB_OK;

@@ -119,6 +119,9 @@ int tcb_harness_load_plugins(const tcb_config *cfg, tcb_error *err);
  * (harness/runner.c) */
 int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, const char *name,
                               tcb_sequence *seq, tcb_error *err);
+/* <splits_dir>/<dataset>/<sequence>.json: where the sequence's split lives. */
+int tcb_harness_split_path(const tcb_config *cfg, const tcb_dataset_spec *d, const tcb_sequence_spec *s,
+                           char *path, size_t size, tcb_error *err);
 /* <splits_dir>/<dataset>/<sequence>.json into *split (made once, then
  * reused; a file made for other settings, frames or blocks than seq's is
  * refused, so every method sees the same pairs); its path in path[size]. */
@@ -159,11 +162,35 @@ typedef struct tcb_cell_job {
 int tcb_fit_time_save(const char *checkpoint, double fit_s, tcb_error *err);
 int tcb_fit_time_load(const char *checkpoint, double *fit_s, tcb_error *err);
 
+/* The cell's identity from the job: names, method_impl (ops->name),
+ * params, seed, split, git revision, load_s; status ok, empty summary.
+ * (harness/cell.c) */
+int tcb_cell_identity(const tcb_cell_job *job, tcb_cell_result *c, tcb_error *err);
+
 /* Runs one cell into *out (status ok, failed or diverged). A method's error
  * is recorded in the cell, not returned: the return value is non-zero only
  * for harness failures (out of memory, metrics given bad input). Free *out
  * with tcb_cell_free. (harness/cell.c) */
 int tcb_cell_run(const tcb_cell_job *job, tcb_cell_result *out, tcb_error *err);
+
+/* One evaluation pair's prediction: a method's transfer, or what `tcbench
+ * score` read from a file. */
+typedef struct tcb_pair_prediction {
+    int i, j;                 /* frames: source, target */
+    const float *moved;       /* [n_verts][3] frame i's vertices carried onto frame j; NULL
+                               * when pred already holds the ids */
+    int32_t *pred;            /* [n_verts] the predicted vertex of frame j per vertex; the
+                               * projection of moved is written here */
+    double cd;                /* the pair's Chamfer distance; NaN without reconstructions */
+} tcb_pair_prediction;
+
+/* Scores one pair: moved (when given) projected onto frame j's nearest GT
+ * vertices, the metrics (into *pm; may be NULL), the cell file's record
+ * into *rec, and the pair added to *sum. The one path from a prediction to
+ * a cell's numbers, for methods' cells and scored cells alike, so a metric
+ * added here reaches both. (harness/cell.c) */
+int tcb_cell_score_pair(const tcb_sequence *seq, const tcb_pair_prediction *p, tcb_pair_record *rec,
+                        tcb_summary *sum, tcb_pair_metrics *pm, tcb_error *err);
 
 /* One evaluation pair of a cell exactly as tcb_cell_run computes it (same
  * method state, random stream and projection), with what it produced. */
@@ -183,6 +210,16 @@ typedef struct tcb_pair_capture {
  * (harness/cell.c) */
 int tcb_cell_eval_pair(const tcb_cell_job *job, int k, tcb_pair_capture *out, tcb_error *err);
 void tcb_pair_capture_free(tcb_pair_capture *c);
+
+/* The prediction directory of `tcbench score` (tcb/score.h;
+ * harness/score_files.c). check_dir: dir holds 0.npy … <n_pairs-1>.npy and
+ * no <k>.npy beyond (the split's path is for the messages).
+ * read_prediction: one file on a frame of nv vertices, into pred[nv] (ids;
+ * *is_points = 0) or moved[nv][3] (points; *is_points = 1). Errors name the
+ * file. */
+int tcb_score_check_dir(const char *dir, int n_pairs, const char *split_path, tcb_error *err);
+int tcb_score_read_prediction(const char *path, int nv, int32_t *pred, float *moved, int *is_points,
+                              tcb_error *err);
 
 /* `tcbench datasets align`: the rotation alignment of an OBJ directory
  * (centred per frame) written as JSON to `out` and, with `plot`, as a PNG

@@ -18,7 +18,7 @@
 enum {
     F_OUT, F_ONLY, F_FORCE, F_QUIET, F_REPORT, F_SEED, F_FRAMES, F_SEQUENCE, F_UPDATE,
     F_PLUGIN, F_THREADS, F_VERBOSE, F_SAMPLES, F_PLOT, F_ROOT, F_VARIANT, F_DRY_RUN, F_REFERENCE, F_CELL,
-    F_SHARD, F_LOCK_TIMEOUT, F_HELP, F_COUNT
+    F_SHARD, F_LOCK_TIMEOUT, F_DATASET, F_PRED, F_NAME, F_HELP, F_COUNT
 };
 #define BIT(f) (1u << (f))
 
@@ -33,6 +33,7 @@ static const struct {
     [F_SAMPLES] = {"--samples", 1}, [F_PLOT] = {"--plot", 1}, [F_ROOT] = {"--root", 1},
     [F_VARIANT] = {"--variant", 1}, [F_DRY_RUN] = {"--dry-run", 0}, [F_REFERENCE] = {"--reference", 1},
     [F_CELL] = {"--cell", 1},    [F_SHARD] = {"--shard", 1},   [F_LOCK_TIMEOUT] = {"--lock-timeout", 1},
+    [F_DATASET] = {"--dataset", 1}, [F_PRED] = {"--pred", 1},  [F_NAME] = {"--name", 1},
     [F_HELP] = {"--help", 0},
 };
 
@@ -365,6 +366,32 @@ static int cmd_inspect(const cli *c)
     return 0;
 }
 
+static int cmd_score(const cli *c)
+{
+    static const struct { int flag; const char *text; } required[] = {
+        {F_DATASET, "--dataset D"}, {F_SEQUENCE, "--sequence S"}, {F_PRED, "--pred DIR"}, {F_NAME, "--name LABEL"}};
+    for (size_t k = 0; k < sizeof required / sizeof required[0]; k++)
+        if (!c->value[required[k].flag]) return usage_error("score", "%s is required", required[k].text);
+    long long seed;
+    if (int_option(c, F_SEED, 0, &seed)) return 2;
+    if (seed > 1000000000) return usage_error("score", "--seed %lld is too large", seed);
+    tcb_config cfg;
+    int rc = load_config(c, &cfg);
+    if (rc) return rc;
+    tcb_score_opts o = {c->value[F_DATASET], c->value[F_SEQUENCE], c->value[F_PRED], c->value[F_NAME], (int)seed,
+                        c->value[F_OUT], c->set[F_FORCE]};
+    tcb_error err = {0};
+    char path[TCB_PATH_MAX];
+    tcb_summary s;
+    rc = tcb_score(&cfg, &o, path, &s, &err);
+    tcb_config_free(&cfg);
+    if (rc) return fail(&err);
+    printf("%s/%s %s: %d pairs, m_sL2 %.2f  rank %.2f  AUC %.2f  CD -\n", o.dataset, o.sequence, o.label,
+           s.n_pairs, 1e3 * s.sl2.mean, 1e2 * s.rank.mean, 1e2 * s.auc.mean);
+    fprintf(stderr, "cell: %s\n", path);
+    return 0;
+}
+
 static int cmd_version(const cli *c)
 {
     (void)c;
@@ -554,6 +581,42 @@ static const command commands[] = {
      "\n"
      "example:\n"
      "  tcbench inspect runs/atlas-cat mca worst --seed 1\n"},
+    {"score", cmd_score,
+     BIT(F_DATASET) | BIT(F_SEQUENCE) | BIT(F_PRED) | BIT(F_NAME) | BIT(F_SEED) | BIT(F_OUT) | BIT(F_FORCE) |
+         BIT(F_ROOT) | BIT(F_VARIANT) | BIT(F_THREADS),
+     1, 1, "CONFIG",
+     "usage: tcbench score CONFIG --dataset D --sequence S --pred DIR --name LABEL [--seed S]\n"
+     "                    [--out DIR] [--force] [--root DATASET=DIR]... [--variant NAME] [--threads N]\n"
+     "\n"
+     "Scores correspondences computed anywhere as a cell of the config's run. DIR\n"
+     "holds one NumPy .npy file per evaluation pair of the sequence's common split,\n"
+     "named by the pair's index (0.npy, 1.npy, ...; pair k is the split file's\n"
+     "pairs[k] = [i, j]): for each of the K vertices of frame i, either the predicted\n"
+     "vertex id of frame j (integers, shape (K,)) or the predicted point on frame j\n"
+     "(float32 or float64, shape (K, 3), projected onto frame j's vertices as a\n"
+     "method's transfer is). The pairs are scored by the code that scores a method's\n"
+     "cells, and the cell goes to RUN/cells/D/S/LABEL/seed_<S>.json, so 'report' and\n"
+     "'check' show it as a row (CD '-': the files hold no reconstructions). A missing\n"
+     "file, a wrong shape or dtype, an id out of range, a NaN or a file that is no\n"
+     ".npy is an error naming the file, and nothing is written. docs/formats.md\n"
+     "describes the files, with a numpy example.\n"
+     "\n"
+     "options:\n"
+     "  --dataset D     a dataset of the config\n"
+     "  --sequence S    one of its sequences\n"
+     "  --pred DIR      the prediction files\n"
+     "  --name LABEL    the row's name; not a label of one of the config's methods\n"
+     "  --seed S        the cell's seed (default 0): several prediction sets of one\n"
+     "                  method are several seeds of one row\n"
+     "  --out DIR       run directory (default: the config's \"output\")\n"
+     "  --force         replace the cell when it exists\n"
+     "  --root D=DIR    the data of dataset D, as for run\n"
+     "  --variant NAME  the config's variant, as for run\n"
+     "  --threads N     threads for the projection and the metrics\n"
+     "\n"
+     "example:\n"
+     "  tcbench score configs/quick.json --dataset synth --sequence quadruped_walk \\\n"
+     "      --pred predictions/ --name my_method\n"},
     {"version", cmd_version, 0, 0, 0, "",
      "usage: tcbench version\n"
      "\n"
@@ -586,6 +649,7 @@ static const char general_help[] =
     "  datasets  list or export the synthetic sequences, align an OBJ sequence's rotations\n"
     "  check     compare a run with a baseline (CI regression check)\n"
     "  inspect   one evaluation pair as coloured meshes, checked against the run\n"
+    "  score     score correspondences computed elsewhere (.npy files) as a cell of a run\n"
     "  version   print the version\n"
     "  help      help on a command\n"
     "\n"

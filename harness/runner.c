@@ -164,11 +164,17 @@ int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, 
     return TCB_OK;
 }
 
+int tcb_harness_split_path(const tcb_config *cfg, const tcb_dataset_spec *d, const tcb_sequence_spec *s,
+                           char *path, size_t size, tcb_error *err)
+{
+    return tcb_path_join(path, size, err, "%s/%s/%s.json", cfg->splits_dir, d->name, s->name);
+}
+
 int tcb_harness_obtain_split(const tcb_config *cfg, const tcb_dataset_spec *d,
                              const tcb_sequence_spec *s, const tcb_sequence *seq, char *path,
                              size_t size, tcb_split *split, tcb_error *err)
 {
-    int rc = tcb_path_join(path, size, err, "%s/%s/%s.json", cfg->splits_dir, d->name, s->name);
+    int rc = tcb_harness_split_path(cfg, d, s, path, size, err);
     if (rc) return rc;
     return tcb_split_obtain(path, d->name, s->name, s->role, seq->n_frames, seq->blocks, seq->n_blocks,
                             cfg->eval_pairs, cfg->split_seed, split, err);

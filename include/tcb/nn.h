@@ -20,6 +20,9 @@ extern "C" {
 
 typedef struct tcb_nn tcb_nn;
 
+/* The largest coordinate magnitude the search takes. */
+#define TCB_NN_COORD_MAX 1e18f
+
 /* Index over n points (xyz floats, row-major). The points are copied.
  * Coordinates that are not finite or beyond ±1e18 (where squared distances
  * could overflow) are an error (TCB_ERR_NUMERIC), for queries too. */

@@ -24,7 +24,10 @@
  *                 "rank": {…}, "auc": {…}, "cd": {…} | null, "pck": [100]},
  *     "pair_columns": ["i","j","n","sl2","sl2_m2","sl2sq","sl2sq_m2",
  *                      "rank","rank_m2","auc","cd"],
- *     "pairs": [[…], …] }                    (cd is null without reconstruction) */
+ *     "pairs": [[…], …] }                    (cd is null without reconstruction)
+ * "message" says why a failed or diverged cell failed; a cell written by
+ * `tcbench score` (tcb/score.h) says "scored from files" there, with
+ * method_impl "scored" and params {"pred_dir": …}. */
 #ifndef TCB_RESULTS_H
 #define TCB_RESULTS_H
 

@@ -21,6 +21,8 @@
 #include "tcb/config.h"
 #include "tcb/runner.h"
 #include "tcb/inspect.h"
+#include "tcb/npy.h"
+#include "tcb/score.h"
 #include "tcb/report.h"
 
 #define TCB_VERSION "0.1.0"

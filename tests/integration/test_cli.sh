@@ -10,7 +10,7 @@ trap 'rm -rf "$tmp"' EXIT
 cd "$tmp"
 
 # ---- help and usage errors
-for cmd in run report methods datasets check version help; do
+for cmd in run report methods datasets check score version help; do
     expect 0 "usage: tcbench $cmd" "$TCBENCH" "$cmd" --help
     grep -q "^example" out.txt || { echo "FAIL: $cmd --help has no example"; exit 1; }
     expect 0 "usage: tcbench $cmd" "$TCBENCH" help "$cmd"

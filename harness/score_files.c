@@ -1,0 +1,105 @@
+/* The prediction directory of `tcbench score` (tcb/score.h): which files
+ * it must hold, and one file read into vertex ids or points. Every error
+ * names the file. */
+#include <dirent.h>
+#include <inttypes.h>
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness/internal.h"
+#include "tcb/fsutil.h"
+#include "tcb/nn.h"
+#include "tcb/npy.h"
+
+/* k when name is "<k>.npy" written as the format names files (no sign, no
+ * leading zero; LONG_MAX past nine digits), else -1. */
+static long pair_file_index(const char *name)
+{
+    size_t n = strspn(name, "0123456789");
+    if (n == 0 || strcmp(name + n, ".npy") || (name[0] == '0' && n > 1)) return -1;
+    return n > 9 ? LONG_MAX : strtol(name, NULL, 10);
+}
+
+int tcb_score_check_dir(const char *dir, int n_pairs, const char *split_path, tcb_error *err)
+{
+    char path[TCB_PATH_MAX];
+    if (!tcb_is_dir(dir)) return tcb_fail(err, TCB_ERR_IO, "%s: no such directory", dir);
+    for (int k = 0; k < n_pairs; k++) {
+        int rc = tcb_path_join(path, sizeof path, err, "%s/%d.npy", dir, k);
+        if (rc) return rc;
+        if (!tcb_is_file(path))
+            return tcb_fail(err, TCB_ERR_IO, "%s: no such file (one file per pair of %s: 0.npy to %d.npy)", path,
+                            split_path, n_pairs - 1);
+    }
+    /* A file past the split's end means predictions for another split. */
+    DIR *d = opendir(dir);
+    if (!d) return tcb_fail(err, TCB_ERR_IO, "%s: cannot list the directory", dir);
+    int rc = TCB_OK;
+    for (struct dirent *e; !rc && (e = readdir(d));) {
+        if (pair_file_index(e->d_name) >= n_pairs)
+            rc = tcb_fail(err, TCB_ERR_INPUT, "%s/%s: %s has only %d pairs (0.npy to %d.npy): predictions for another split?",
+                          dir, e->d_name, split_path, n_pairs, n_pairs - 1);
+    }
+    closedir(d);
+    return rc;
+}
+
+/* Vertex ids: integers (any width and byte order), each in [0, nv). */
+static int read_ids(const tcb_npy *a, int nv, int32_t *pred, tcb_error *err)
+{
+    if (a->kind != 'i' && a->kind != 'u')
+        return tcb_fail(err, TCB_ERR_INPUT, "dtype %s: vertex ids (shape (%d,)) must be integers%s", a->descr, nv,
+                        a->kind == 'f' ? " (floats are not rounded to ids)" : "");
+    int64_t *ids = malloc((size_t)nv * sizeof *ids);
+    if (!ids) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory for %d ids", nv);
+    int rc = tcb_npy_to_int64(a, ids, err);
+    for (int k = 0; !rc && k < nv; k++) {
+        if (ids[k] < 0 || ids[k] >= nv)
+            rc = tcb_fail(err, TCB_ERR_INPUT, "element %d: vertex id %" PRId64 " out of range [0, %d)", k, ids[k], nv);
+        pred[k] = (int32_t)ids[k];
+    }
+    free(ids);
+    return rc;
+}
+
+/* Points: float32 or float64, finite, within the nearest-vertex search's
+ * range. Methods transfer float32 points, so a float64 point is rounded to
+ * the nearest float32, the precision every method's transfer has. */
+static int read_points(const tcb_npy *a, int nv, float *moved, tcb_error *err)
+{
+    if (a->kind != 'f')
+        return tcb_fail(err, TCB_ERR_INPUT, "dtype %s: points (shape (%d, 3)) must be float32 or float64", a->descr,
+                        nv);
+    size_t n = (size_t)nv * 3;
+    double *xyz = malloc(n * sizeof *xyz);
+    if (!xyz) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory for %d points", nv);
+    int rc = tcb_npy_to_double(a, xyz, err);
+    for (size_t k = 0; !rc && k < n; k++) {
+        if (!(fabs(xyz[k]) <= TCB_NN_COORD_MAX))
+            rc = tcb_fail(err, TCB_ERR_INPUT, "point %zu, coordinate %zu: %s", k / 3, k % 3,
+                          isnan(xyz[k]) ? "NaN" : isinf(xyz[k]) ? "infinite" : "beyond ±1e18");
+        moved[k] = (float)xyz[k];
+    }
+    free(xyz);
+    return rc;
+}
+
+int tcb_score_read_prediction(const char *path, int nv, int32_t *pred, float *moved, int *is_points, tcb_error *err)
+{
+    tcb_npy a;
+    int rc = tcb_npy_load(path, &a, err); /* its errors name the file */
+    if (rc) return rc;
+    char shape[64];
+    tcb_npy_shape_text(&a, shape, sizeof shape);
+    *is_points = a.ndim == 2;
+    if (a.ndim == 1 && a.shape[0] == (uint64_t)nv) rc = read_ids(&a, nv, pred, err);
+    else if (a.ndim == 2 && a.shape[0] == (uint64_t)nv && a.shape[1] == 3) rc = read_points(&a, nv, moved, err);
+    else
+        rc = tcb_fail(err, TCB_ERR_INPUT, "shape %s: expected (%d,) vertex ids or (%d, 3) points (one per vertex of the frame)",
+                      shape, nv, nv);
+    tcb_npy_free(&a);
+    if (rc) tcb_error_prefix(err, "%s: ", path);
+    return rc;
+}
