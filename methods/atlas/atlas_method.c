@@ -46,7 +46,7 @@ typedef struct atlas_method {
     long long checkpoint_every; /* iterations between training checkpoints; 0: none */
     uint64_t seed;              /* of the fit: the UV cache's stream */
     tcb_atlas_model *model;     /* NULL before fit or load */
-    tcb_atlas_uv_cache uvc;
+    tcb_atlas_eval_state eval; /* UV sets and workspaces of the evaluation */
     const tcb_sequence *last_seq; /* the last pair evaluated: (last_seq, last_i, last_j) */
     int last_i, last_j, n_pred;
     float *pred;                /* [2][n_pred][3] its predictions of frames i and j */
@@ -119,8 +119,8 @@ static int new_model(atlas_method *a, uint64_t seed, tcb_error *err)
     tcb_atlas_model_free(a->model);
     a->model = NULL;
     forget_pair(a);
-    tcb_atlas_uv_cache_free(&a->uvc);
-    tcb_atlas_uv_cache_init(&a->uvc, seed);
+    tcb_atlas_eval_state_free(&a->eval);
+    tcb_atlas_eval_state_init(&a->eval, seed);
     a->seed = seed;
     int rc = tcb_atlas_model_create(a->C, a->P, &a->model, err);
     if (rc) return rc;
@@ -193,7 +193,7 @@ static int eval_pair(atlas_method *a, const tcb_sequence *seq, int i, int j, tcb
     if (!clouds) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", a->name);
     int rc = tcb_sequence_draw_points(seq, i, N, seq->draw_with_replacement, rng, clouds, err);
     if (!rc) rc = tcb_sequence_draw_points(seq, j, N, seq->draw_with_replacement, rng, clouds + (size_t)N * 3, err);
-    if (!rc) rc = tcb_atlas_eval_pair(a->model, &a->uvc, clouds, N, &a->pred, &a->n_pred, err);
+    if (!rc) rc = tcb_atlas_eval_pair(a->model, &a->eval, clouds, N, &a->pred, &a->n_pred, err);
     free(clouds);
     if (!rc) a->last_seq = seq, a->last_i = i, a->last_j = j;
     return rc;
@@ -230,7 +230,7 @@ static void destroy(void *self)
     atlas_method *a = self;
     if (!a) return;
     tcb_atlas_model_free(a->model);
-    tcb_atlas_uv_cache_free(&a->uvc);
+    tcb_atlas_eval_state_free(&a->eval);
     free(a->pred);
     free(a);
 }
@@ -264,9 +264,9 @@ static int load(void *self, const tcb_sequence *seq, const char *path, tcb_error
     rc = tcb_model_file_read(path, MAGIC, want, &seed, &w, err);
     cJSON_Delete(want);
     if (!rc) {
-        /* the UV cache belongs to the fit's seed */
-        tcb_atlas_uv_cache_free(&a->uvc);
-        tcb_atlas_uv_cache_init(&a->uvc, seed);
+        /* the UV sets belong to the fit's seed */
+        tcb_atlas_eval_state_free(&a->eval);
+        tcb_atlas_eval_state_init(&a->eval, seed);
         a->seed = seed;
     } else {
         tcb_atlas_model_free(a->model);
