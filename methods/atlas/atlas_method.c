@@ -283,10 +283,12 @@ static const tcb_step_cost step_costs[][3] = {
     [1] = {{0.0408, 0.0247, "Zen 4"}, {0, 0.0356, "Zen 4"}, {0.0635, 0.0352, "Zen 4"}}, /* cpu */
 };
 /* An evaluation pair: two forward passes, the collapse test, the regular
- * UV samples and the nearest-neighbour transfer: 97.7 s for the cat's 500
- * pairs at the cpu preset, 1 thread, beside another training (an upper
- * figure; mca, seed 0, 2026-12-02). */
-#define EVAL_PAIR_S 0.195
+ * UV samples and the nearest-neighbour transfer, with the harness's
+ * metrics: 36.2 CPU-seconds for a cat cell at the cpu preset, 1 thread
+ * (perf stat task-clock, 10 training steps and the load included; mca,
+ * seed 0, 2026-12-02, after the evaluation kept its workspaces), i.e.
+ * about 0.065 s a pair on an idle core. */
+#define EVAL_PAIR_S 0.065
 
 static void estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out)
 {
