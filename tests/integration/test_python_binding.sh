@@ -26,7 +26,7 @@ sanitizer_env=()
 if readelf -d "$lib" | grep -q 'NEEDED.*libasan'; then
     sanitizer_env=(LD_PRELOAD="$("${CC:-gcc}" -print-file-name=libasan.so)" ASAN_OPTIONS=detect_leaks=0)
 fi
-py() { env "${sanitizer_env[@]}" PYTHONPATH="$TCB_SOURCE_DIR/python" TCBENCH_LIB="$lib" /usr/bin/python3 "$@"; }
+py() { env "${sanitizer_env[@]}" PYTHONDONTWRITEBYTECODE=1 PYTHONPATH="$TCB_SOURCE_DIR/python" TCBENCH_LIB="$lib" /usr/bin/python3 "$@"; }
 
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
