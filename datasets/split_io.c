@@ -77,6 +77,14 @@ int tcb_split_save(const char *path, const tcb_split *s, tcb_error *err)
     return rc;
 }
 
+char *tcb_split_json(const tcb_split *s)
+{
+    cJSON *root = split_to_json(s);
+    char *text = root ? cJSON_PrintUnformatted(root) : NULL; /* cJSON allocates with malloc */
+    cJSON_Delete(root);
+    return text;
+}
+
 static int load_name(const cJSON *root, const char *key, const char *where, char *out,
                      size_t size, tcb_error *err)
 {

@@ -175,6 +175,11 @@ static void reconstruction_cd(const tcb_cell_job *job, void *self, int i, int j,
     free(pts);
 }
 
+tcb_pair_record tcb_pair_record_of(int i, int j, const tcb_pair_metrics *m, double cd)
+{
+    return (tcb_pair_record){i, j, m->sl2, m->sl2sq, m->rank, m->auc, cd};
+}
+
 int tcb_cell_score_pair(const tcb_sequence *seq, const tcb_pair_prediction *p, tcb_pair_record *rec,
                         tcb_summary *sum, tcb_pair_metrics *pm, tcb_error *err)
 {
@@ -184,7 +189,7 @@ int tcb_cell_score_pair(const tcb_sequence *seq, const tcb_pair_prediction *p, t
     int rc = p->moved ? tcb_project_to_vertices(verts_j, nv, p->moved, nv, p->pred, err) : TCB_OK;
     if (!rc) rc = tcb_pair_metrics_compute(verts_j, nv, p->pred, &m, err);
     if (rc) return rc;
-    *rec = (tcb_pair_record){p->i, p->j, m.sl2, m.sl2sq, m.rank, m.auc, p->cd};
+    *rec = tcb_pair_record_of(p->i, p->j, &m, p->cd);
     tcb_summary_add_pair(sum, &m, p->cd);
     if (pm) *pm = m;
     return TCB_OK;

@@ -288,6 +288,21 @@ int tcb_method_runs_on(const tcb_method_spec *m, const char *dataset)
     return m->n_only_on == 0;
 }
 
+int tcb_config_find_sequence(const tcb_config *c, const char *dataset, const char *sequence,
+                             const tcb_dataset_spec **d, const tcb_sequence_spec **s, tcb_error *err)
+{
+    *d = NULL, *s = NULL;
+    for (int k = 0; k < c->n_datasets && !*d; k++)
+        if (!strcmp(c->datasets[k].name, dataset)) *d = &c->datasets[k];
+    if (!*d) return tcb_fail(err, TCB_ERR_INPUT, "%s has no dataset named '%s'", c->path, dataset);
+    for (int k = 0; k < (*d)->n_sequences && !*s; k++)
+        if (!strcmp((*d)->sequences[k].name, sequence)) *s = &(*d)->sequences[k];
+    if (!*s)
+        return tcb_fail(err, TCB_ERR_INPUT, "dataset %s of %s has no sequence named '%s'", dataset, c->path,
+                        sequence);
+    return TCB_OK;
+}
+
 static int parse_method(const cJSON *o, const char *where, const tcb_config *c,
                         tcb_method_spec *m, tcb_error *err)
 {

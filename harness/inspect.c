@@ -369,13 +369,10 @@ int tcb_inspect(const tcb_inspect_opts *o, FILE *out, char *out_path, tcb_error 
                            t.d->name, t.s->name, t.m->label, t.seed, k);
     if (!rc && !(verr = malloc((size_t)seq.n_verts * sizeof *verr)))
         rc = tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
+    /* Each vertex's error as the metrics compute it (their sL2 is its mean). */
+    if (!rc) rc = tcb_pair_vertex_metrics(tcb_seq_frame(&seq, cap.j), seq.n_verts, cap.pred, verr, NULL, err);
     if (!rc) {
-        const float *vj = tcb_seq_frame(&seq, cap.j);
-        for (int v = 0; v < seq.n_verts; v++) {
-            const float *p = vj + 3 * (size_t)cap.pred[v], *q = vj + 3 * (size_t)v;
-            double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
-            verr[v] = sqrt(dx * dx + dy * dy + dz * dz);
-        }
+        for (int v = 0; v < seq.n_verts; v++) verr[v] = sqrt(verr[v]);
         cell_row row;
         load_cell_row(o->run_dir, &t, k, &row);
         double diff = row.found ? row_difference(&cap, &row.rec) : 0;

@@ -40,6 +40,8 @@ int tcb_run_check_methods(const tcb_config *cfg, const tcb_run_opts *opts, tcb_e
 int tcb_run_root_missing(const tcb_dataset_spec *d);
 /* why: "no root given (--root NAME=DIR or TCBENCH_ROOT_NAME)" or "<root> not found". */
 void tcb_run_missing_root_text(const tcb_dataset_spec *d, char *out, size_t size);
+/* TCB_ERR_INPUT "<config>: dataset <name>: <why>" when d's data cannot be read. */
+int tcb_run_check_root(const tcb_config *cfg, const tcb_dataset_spec *d, tcb_error *err);
 
 /* The grid in cell-id order (harness/grid.c). */
 typedef struct tcb_grid_cell {
@@ -183,6 +185,10 @@ typedef struct tcb_pair_prediction {
                                * projection of moved is written here */
     double cd;                /* the pair's Chamfer distance; NaN without reconstructions */
 } tcb_pair_prediction;
+
+/* The cell file's record of pair (i, j): its metrics and Chamfer distance
+ * (NaN: none). (harness/cell.c) */
+tcb_pair_record tcb_pair_record_of(int i, int j, const tcb_pair_metrics *m, double cd);
 
 /* Scores one pair: moved (when given) projected onto frame j's nearest GT
  * vertices, the metrics (into *pm; may be NULL), the cell file's record

@@ -122,6 +122,15 @@ static void add_summary(builder *b, cJSON *root, const tcb_summary *s)
     for (int k = 0; pck && k < TCB_PCK_STEPS; k++) append(b, pck, num_or_null(s->pck[k]));
 }
 
+void tcb_pair_record_row(const tcb_pair_record *r, double *v)
+{
+    const double row[TCB_N_PAIR_COLUMNS] = {r->i,         r->j,          r->sl2.n,
+                                            r->sl2.mean,  r->sl2.m2,     r->sl2sq.mean,
+                                            r->sl2sq.m2,  r->rank.mean,  r->rank.m2,
+                                            r->auc,       r->cd};
+    memcpy(v, row, sizeof row);
+}
+
 /* pairs: [n_pairs][TCB_N_PAIR_COLUMNS] in tcb_cell_pair_columns order. */
 static void add_pairs(builder *b, cJSON *root, const tcb_cell_result *c)
 {
@@ -130,11 +139,8 @@ static void add_pairs(builder *b, cJSON *root, const tcb_cell_result *c)
     cJSON *rows = add(b, root, "pairs", cJSON_CreateArray());
     if (!cols || !rows) return;
     for (int p = 0; p < c->n_pairs && b->ok; p++) {
-        const tcb_pair_record *r = &c->pairs[p];
-        const double v[TCB_N_PAIR_COLUMNS] = {r->i,         r->j,          r->sl2.n,
-                                              r->sl2.mean,  r->sl2.m2,     r->sl2sq.mean,
-                                              r->sl2sq.m2,  r->rank.mean,  r->rank.m2,
-                                              r->auc,       r->cd};
+        double v[TCB_N_PAIR_COLUMNS];
+        tcb_pair_record_row(&c->pairs[p], v);
         cJSON *row = cJSON_CreateArray();
         if (!append(b, rows, row)) return;
         for (int k = 0; k < TCB_N_PAIR_COLUMNS; k++) append(b, row, num_or_null(v[k]));
@@ -165,7 +171,7 @@ static int check_for_save(const char *path, const tcb_cell_result *c, tcb_error 
     return TCB_OK;
 }
 
-static cJSON *cell_to_json(const char *path, const tcb_cell_result *c, tcb_error *err)
+cJSON *tcb_cell_to_json(const char *path, const tcb_cell_result *c, tcb_error *err)
 {
     cJSON *params = cJSON_Parse(c->params_json ? c->params_json : "{}");
     if (!cJSON_IsObject(params)) {
@@ -192,7 +198,8 @@ static cJSON *cell_to_json(const char *path, const tcb_cell_result *c, tcb_error
     add_str(&b, root, "status", tcb_cell_status_name(c->status));
     add_str(&b, root, "message", c->message);
     add_str(&b, root, "git_revision", c->git_revision);
-    add_str(&b, root, "tcbench_version", TCB_VERSION);
+    /* A loaded cell keeps the version that wrote it when written again. */
+    add_str(&b, root, "tcbench_version", c->tcbench_version[0] ? c->tcbench_version : TCB_VERSION);
     cJSON *t = add(&b, root, "timings", cJSON_CreateObject());
     if (t) {
         add_num(&b, t, "load_s", c->load_s);
@@ -220,7 +227,7 @@ int tcb_cell_save(const char *path, const tcb_cell_result *c, tcb_error *err)
 {
     int rc = check_for_save(path, c, err);
     if (rc) return rc;
-    cJSON *root = cell_to_json(path, c, err);
+    cJSON *root = tcb_cell_to_json(path, c, err);
     if (!root) return err ? (int)err->code : TCB_ERR_INPUT;
     rc = tcb_json_save(path, root, err);
     cJSON_Delete(root);

@@ -8,6 +8,10 @@
 #ifndef TCB_HARNESS_RESULTS_FORMAT_H
 #define TCB_HARNESS_RESULTS_FORMAT_H
 
+#include <cjson/cJSON.h>
+
+#include "tcb/results.h"
+
 /* Largest integer a JSON number (a double) holds exactly. */
 #define TCB_JSON_INT_MAX 9007199254740992.0
 
@@ -16,5 +20,14 @@
 extern const char *const tcb_cell_status_names[]; /* indexed by tcb_cell_status; NULL-terminated */
 extern const char *const tcb_cell_role_names[];   /* "train", "validation", "test", NULL */
 extern const char *const tcb_cell_pair_columns[]; /* [TCB_N_PAIR_COLUMNS], NULL-terminated */
+
+/* A pair's row of the file, v[TCB_N_PAIR_COLUMNS] in tcb_cell_pair_columns
+ * order (non-finite values are written as null). */
+void tcb_pair_record_row(const tcb_pair_record *r, double *v);
+
+/* The cell as the file's JSON tree (for tcb_cell_save, and for a binding
+ * that hands a loaded cell on as text); NULL on failure, with the error
+ * naming `path`. */
+cJSON *tcb_cell_to_json(const char *path, const tcb_cell_result *c, tcb_error *err);
 
 #endif

@@ -229,11 +229,11 @@ static int load_header(const cJSON *root, const char *where, tcb_cell_result *c,
     if ((rc = tcb_json_enum(root, "status", where, 1, 0, tcb_cell_status_names, &idx, err)))
         return rc;
     c->status = (tcb_cell_status)idx;
-    const char *version;
     if ((rc = copy_str(root, "message", where, c->message, sizeof c->message, err)) ||
         (rc = copy_str(root, "git_revision", where, c->git_revision, sizeof c->git_revision,
                        err)) ||
-        (rc = tcb_json_str(root, "tcbench_version", where, 1, NULL, &version, err)) ||
+        (rc = copy_str(root, "tcbench_version", where, c->tcbench_version,
+                       sizeof c->tcbench_version, err)) ||
         (rc = tcb_json_int(root, "peak_rss_kb", where, 1, 0, 0, (long long)TCB_JSON_INT_MAX, &v,
                            err)))
         return rc;

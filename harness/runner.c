@@ -164,6 +164,17 @@ int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, 
     return TCB_OK;
 }
 
+int tcb_run_load_sequence(const tcb_config *cfg, const char *dataset, const char *sequence, tcb_sequence *out,
+                          tcb_error *err)
+{
+    const tcb_dataset_spec *d;
+    const tcb_sequence_spec *s;
+    memset(out, 0, sizeof *out);
+    int rc = tcb_config_find_sequence(cfg, dataset, sequence, &d, &s, err);
+    if (!rc) rc = tcb_run_check_root(cfg, d, err);
+    return rc ? rc : tcb_harness_load_sequence(cfg, d, s->name, out, err);
+}
+
 int tcb_harness_split_path(const tcb_config *cfg, const tcb_dataset_spec *d, const tcb_sequence_spec *s,
                            char *path, size_t size, tcb_error *err)
 {
@@ -381,6 +392,14 @@ void tcb_run_missing_root_text(const tcb_dataset_spec *d, char *out, size_t size
     tcb_config_root_env_name(d->name, var, sizeof var);
     if (d->root[0]) snprintf(out, size, "%s not found", d->root);
     else snprintf(out, size, "no root given (--root %s=DIR or %s)", d->name, var);
+}
+
+int tcb_run_check_root(const tcb_config *cfg, const tcb_dataset_spec *d, tcb_error *err)
+{
+    if (!tcb_run_root_missing(d)) return TCB_OK;
+    char why[TCB_PATH_MAX + 64];
+    tcb_run_missing_root_text(d, why, sizeof why);
+    return tcb_fail(err, TCB_ERR_INPUT, "%s: dataset %s: %s", cfg->path, d->name, why);
 }
 
 /* Missing data is found before any cell runs, not hours into the run. */

@@ -29,18 +29,12 @@ typedef struct target {
     const tcb_sequence_spec *s;
 } target;
 
+/* The messages name the option that chose what is missing. */
 static int find_target(const tcb_config *cfg, const tcb_score_opts *o, target *t, tcb_error *err)
 {
-    t->d = NULL, t->s = NULL;
-    for (int k = 0; k < cfg->n_datasets && !t->d; k++)
-        if (!strcmp(cfg->datasets[k].name, o->dataset)) t->d = &cfg->datasets[k];
-    if (!t->d) return tcb_fail(err, TCB_ERR_INPUT, "--dataset: %s has no dataset named '%s'", cfg->path, o->dataset);
-    for (int k = 0; k < t->d->n_sequences && !t->s; k++)
-        if (!strcmp(t->d->sequences[k].name, o->sequence)) t->s = &t->d->sequences[k];
-    if (!t->s)
-        return tcb_fail(err, TCB_ERR_INPUT, "--sequence: dataset %s of %s has no sequence named '%s'", o->dataset,
-                        cfg->path, o->sequence);
-    return TCB_OK;
+    int rc = tcb_config_find_sequence(cfg, o->dataset, o->sequence, &t->d, &t->s, err);
+    if (rc) tcb_error_prefix(err, "%s", t->d ? "--sequence: " : "--dataset: ");
+    return rc;
 }
 
 /* A configured method's label would put the scored cell among the cells
@@ -56,14 +50,6 @@ static int check_label(const tcb_config *cfg, const char *label, tcb_error *err)
                             "--name: %s has a method labelled '%s' (its cells are tcbench run's); choose another name",
                             cfg->path, label);
     return TCB_OK;
-}
-
-static int check_root(const tcb_config *cfg, const tcb_dataset_spec *d, tcb_error *err)
-{
-    if (!tcb_run_root_missing(d)) return TCB_OK;
-    char why[TCB_PATH_MAX + 64];
-    tcb_run_missing_root_text(d, why, sizeof why);
-    return tcb_fail(err, TCB_ERR_INPUT, "%s: dataset %s: %s", cfg->path, d->name, why);
 }
 
 /* {"pred_dir": dir}, escaped as JSON; malloc'ed, NULL when out of memory. */
@@ -163,7 +149,7 @@ int tcb_score(const tcb_config *cfg, const tcb_score_opts *o, char *cell_path, t
     if (!rc) rc = tcb_harness_split_path(cfg, t.d, t.s, split_path, sizeof split_path, err);
     /* The split has the config's number of pairs: tcb_split_obtain refuses any other. */
     if (!rc) rc = tcb_score_check_dir(o->pred_dir, cfg->eval_pairs, split_path, err);
-    if (!rc) rc = check_root(cfg, t.d, err);
+    if (!rc) rc = tcb_run_check_root(cfg, t.d, err);
     if (rc) return rc;
     tcb_cell_result c;
     rc = score_cell(cfg, o, &t, &c, err);

@@ -115,37 +115,58 @@ static void pck_curve(const double *d, int nv, tcb_pair_metrics *out)
     out->auc = sum / TCB_PCK_STEPS;
 }
 
-int tcb_pair_metrics_compute(const float *verts_j, int nv, const int32_t *pred,
-                             tcb_pair_metrics *out, tcb_error *err)
+static int check_pred(int nv, const int32_t *pred, tcb_error *err)
 {
     if (nv < 1) return tcb_fail(err, TCB_ERR_INPUT, "metrics: frame has no vertices");
     for (int k = 0; k < nv; k++)
         if (pred[k] < 0 || pred[k] >= nv)
             return tcb_fail(err, TCB_ERR_INPUT, "metrics: pred[%d] = %d outside [0, %d)", k,
                             (int)pred[k], nv);
-    double *buf = malloc((size_t)nv * 5 * sizeof(double));
-    if (!buf) return tcb_fail(err, TCB_ERR_NOMEM, "metrics: out of memory");
-    double *x = buf, *y = x + nv, *z = y + nv, *d = z + nv, *rank = d + nv;
+    return TCB_OK;
+}
+
+int tcb_pair_vertex_metrics(const float *verts_j, int nv, const int32_t *pred, double *sq,
+                            double *rank, tcb_error *err)
+{
+    int rc = check_pred(nv, pred, err);
+    if (rc) return rc;
+    double *x = malloc((size_t)nv * 3 * sizeof(double));
+    if (!x) return tcb_fail(err, TCB_ERR_NOMEM, "metrics: out of memory");
+    double *y = x + nv, *z = y + nv;
     for (int k = 0; k < nv; k++) {
         x[k] = verts_j[3 * k], y[k] = verts_j[3 * k + 1], z[k] = verts_j[3 * k + 2];
     }
     for (int k = 0; k < nv; k++) {
         int p = pred[k];
         double dx = x[p] - x[k], dy = y[p] - y[k], dz = z[p] - z[k];
-        d[k] = dx * dx + dy * dy + dz * dz;
+        sq[k] = dx * dx + dy * dy + dz * dz;
     }
-    if (ranks(x, y, z, nv, d, rank)) {
-        free(buf);
-        return tcb_fail(err, TCB_ERR_NOMEM, "metrics: out of memory");
-    }
+    if (rank && ranks(x, y, z, nv, sq, rank)) rc = tcb_fail(err, TCB_ERR_NOMEM, "metrics: out of memory");
+    free(x);
+    return rc;
+}
 
+void tcb_pair_metrics_summarize(const double *sq, const double *rank, int nv, tcb_pair_metrics *out)
+{
     *out = (tcb_pair_metrics){0};
     for (int k = 0; k < nv; k++) {
-        tcb_stat_push(&out->sl2, sqrt(d[k]));
-        tcb_stat_push(&out->sl2sq, d[k]);
+        tcb_stat_push(&out->sl2, sqrt(sq[k]));
+        tcb_stat_push(&out->sl2sq, sq[k]);
         tcb_stat_push(&out->rank, rank[k]);
     }
-    pck_curve(d, nv, out);
+    pck_curve(sq, nv, out);
+}
+
+int tcb_pair_metrics_compute(const float *verts_j, int nv, const int32_t *pred,
+                             tcb_pair_metrics *out, tcb_error *err)
+{
+    /* Checked first: the buffers are sized by nv. */
+    int rc = check_pred(nv, pred, err);
+    if (rc) return rc;
+    double *buf = malloc((size_t)nv * 2 * sizeof(double));
+    if (!buf) return tcb_fail(err, TCB_ERR_NOMEM, "metrics: out of memory");
+    rc = tcb_pair_vertex_metrics(verts_j, nv, pred, buf, buf + nv, err);
+    if (!rc) tcb_pair_metrics_summarize(buf, buf + nv, nv, out);
     free(buf);
-    return TCB_OK;
+    return rc;
 }

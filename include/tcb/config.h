@@ -143,6 +143,12 @@ int tcb_config_parse_opts(const char *text, const char *origin, const tcb_config
 void tcb_config_root_env_name(const char *dataset, char *out, size_t size);
 void tcb_config_free(tcb_config *c);
 
+/* The dataset and its sequence of those names in c; TCB_ERR_INPUT when
+ * either is missing (*d stays NULL when the dataset is: the message says
+ * which). */
+int tcb_config_find_sequence(const tcb_config *c, const char *dataset, const char *sequence,
+                             const tcb_dataset_spec **d, const tcb_sequence_spec **s, tcb_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -52,9 +52,18 @@ typedef struct tcb_pair_metrics {
 int tcb_project_to_vertices(const float *verts_j, int nv, const float *pts, int n,
                             int32_t *idx, tcb_error *err);
 
-/* Metrics of one pair from predicted vertex ids (pred[k] ∈ [0, nv)). */
+/* Metrics of one pair from predicted vertex ids (pred[k] ∈ [0, nv)):
+ * tcb_pair_vertex_metrics, then tcb_pair_metrics_summarize. */
 int tcb_pair_metrics_compute(const float *verts_j, int nv, const int32_t *pred,
                              tcb_pair_metrics *out, tcb_error *err);
+
+/* The per-vertex values the pair's metrics summarize: sq[k] = d_k and
+ * rank[k] (a fraction), each [nv]; rank may be NULL (not computed, the
+ * costly part). Errors as tcb_pair_metrics_compute's. */
+int tcb_pair_vertex_metrics(const float *verts_j, int nv, const int32_t *pred, double *sq,
+                            double *rank, tcb_error *err);
+/* The pair's metrics from those values (sL2 is sqrt of each sq[k]). */
+void tcb_pair_metrics_summarize(const double *sq, const double *rank, int nv, tcb_pair_metrics *out);
 
 /* Symmetric Chamfer distance of squared nearest-neighbour distances (means). */
 int tcb_chamfer(const float *a, int na, const float *b, int nb, double *out,

@@ -64,6 +64,8 @@ typedef struct tcb_cell_result {
     tcb_cell_status status;
     char message[TCB_ERRMSG_MAX];
     char git_revision[64];
+    char tcbench_version[32];  /* the version that wrote the file; "" in a new cell: the
+                                * writer records its own (TCB_VERSION) */
     double load_s, fit_s, eval_s;
     long peak_rss_kb;
     char split_path[4096];

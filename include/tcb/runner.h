@@ -54,6 +54,16 @@ typedef struct tcb_run_stats {
 int tcb_run(const tcb_config *cfg, const tcb_run_opts *opts, tcb_run_stats *stats,
             tcb_error *err);
 
+/* The sequence `tcbench run` scores the cells of cfg's dataset and
+ * sequence (both by name) on: generated or read (through the config's
+ * cache), normalized, aligned, its pools drawn, its input settings set.
+ * For code outside the runner that needs the very frames the cell files
+ * were computed on (the Python binding's load_sequence). Errors name the
+ * config and what is missing; on failure *out holds nothing. Free with
+ * tcb_sequence_free. */
+int tcb_run_load_sequence(const tcb_config *cfg, const char *dataset, const char *sequence, tcb_sequence *out,
+                          tcb_error *err);
+
 /* The dry run: prints to `out` every cell (numbered in grid order over the
  * whole config), its state in the run directory and the compute it would
  * take, from each method's step costs; loads plug-ins and checks the

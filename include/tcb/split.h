@@ -45,6 +45,9 @@ int tcb_split_make(const char *dataset, const char *sequence, tcb_role role, int
                    tcb_split *out, tcb_error *err);
 int tcb_split_save(const char *path, const tcb_split *s, tcb_error *err); /* JSON, atomic */
 int tcb_split_load(const char *path, tcb_split *out, tcb_error *err);
+/* The split as its file's JSON text (the tree tcb_split_save writes,
+ * unindented); malloc'ed, NULL when out of memory. */
+char *tcb_split_json(const tcb_split *s);
 /* Load `path` if it exists and agrees with the request (dataset, sequence,
  * role, n_frames, blocks, n_pairs, seed), else make and save it.
  * Disagreement is an error (TCB_ERR_INPUT) naming the file and the first

@@ -24,6 +24,7 @@
 #include "tcb/npy.h"
 #include "tcb/score.h"
 #include "tcb/report.h"
+#include "tcb/binding.h"
 
 #define TCB_VERSION "0.1.0"
 

@@ -263,6 +263,47 @@ static void test_pair_vs_reference(void **state)
     }
 }
 
+/* The per-vertex values equal the reference's bit for bit (the same
+ * expressions; a rank is an exact count over K), their summary is the
+ * pair's metrics bit for bit, and rank may be left out. On the lattice
+ * too, where ties decide the ranks. */
+static void check_vertex_metrics(const float *v, int K, const int32_t *pred)
+{
+    double *sq = malloc((size_t)K * sizeof *sq), *rank = malloc((size_t)K * sizeof *rank);
+    double *sq_only = malloc((size_t)K * sizeof *sq_only);
+    assert_int_equal(tcb_pair_vertex_metrics(v, K, pred, sq, rank, NULL), TCB_OK);
+    assert_int_equal(tcb_pair_vertex_metrics(v, K, pred, sq_only, NULL, NULL), TCB_OK);
+    ref_pair r;
+    ref_compute(v, K, pred, &r);
+    for (int k = 0; k < K; k++) {
+        assert_true(sq[k] == r.sl2sq[k] && sq_only[k] == sq[k]);
+        assert_true(rank[k] == r.rank[k]);
+    }
+    tcb_pair_metrics whole, parts;
+    assert_int_equal(tcb_pair_metrics_compute(v, K, pred, &whole, NULL), TCB_OK);
+    tcb_pair_metrics_summarize(sq, rank, K, &parts);
+    assert_memory_equal(&whole, &parts, sizeof whole);
+    ref_free(&r);
+    free(sq), free(rank), free(sq_only);
+}
+
+static void test_vertex_metrics(void **state)
+{
+    (void)state;
+    tcb_rng rng;
+    tcb_rng_seed(&rng, 11);
+    float *v = random_verts(1297, &rng);
+    int32_t *pred = random_pred(1297, &rng);
+    check_vertex_metrics(v, 1297, pred);
+    free(v), free(pred);
+    enum { K = 343 };
+    float lattice[3 * K];
+    for (int k = 0; k < K; k++) lattice[3 * k] = k % 7, lattice[3 * k + 1] = k / 7 % 7, lattice[3 * k + 2] = k / 49;
+    pred = random_pred(K, &rng);
+    check_vertex_metrics(lattice, K, pred);
+    free(pred);
+}
+
 /* Integer coordinates: many exactly equal distances, where < vs ≤ matters. */
 static void test_pair_vs_reference_lattice(void **state)
 {
@@ -496,6 +537,9 @@ static void test_errors(void **state)
     assert_int_equal(tcb_pair_metrics_compute(v, 2, bad, &m, &err), TCB_ERR_INPUT);
     assert_non_null(strstr(err.msg, "pred[1]"));
     assert_int_equal(tcb_pair_metrics_compute(v, 0, bad, &m, &err), TCB_ERR_INPUT);
+    double sq[2];
+    assert_int_equal(tcb_pair_vertex_metrics(v, 2, bad, sq, NULL, &err), TCB_ERR_INPUT);
+    assert_non_null(strstr(err.msg, "pred[1] = 2 outside [0, 2)"));
     double cd;
     assert_int_equal(tcb_chamfer(v, 0, v, 2, &cd, &err), TCB_ERR_INPUT);
     float out[3];
@@ -513,6 +557,7 @@ int main(void)
         cmocka_unit_test(test_thresholds_linspace),
         cmocka_unit_test(test_pair_vs_reference),
         cmocka_unit_test(test_pair_vs_reference_lattice),
+        cmocka_unit_test(test_vertex_metrics),
         cmocka_unit_test(test_project_to_vertices),
         cmocka_unit_test(test_chamfer),
         cmocka_unit_test(test_atlas_transfer),

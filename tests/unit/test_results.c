@@ -15,7 +15,9 @@
 
 #include "tcb/fsutil.h"
 #include "tcb/json.h"
+#include "tcb/binding.h"
 #include "tcb/results.h"
+#include "tcb/tcb.h"
 #include "testutil.h"
 
 /* A fully populated cell; with_cd = 0 models a method without reconstruction. */
@@ -192,6 +194,47 @@ static void test_cell_path_rejects_escapes(void **state)
                      TCB_ERR_INPUT);
     assert_int_equal(tcb_cell_path(path, sizeof path, "run", "d", "s", "m", 7, &err), TCB_OK);
     assert_string_equal(path, "run/cells/d/s/m/seed_7.json");
+}
+
+/* A new cell records this library's version; a loaded one keeps the
+ * version that wrote it when saved again, and the binding's text of a cell
+ * is its file's JSON. */
+static void test_version_kept_and_binding_text(void **state)
+{
+    (void)state;
+    char dir[512], path[4096], again[4200];
+    tu_make_tmpdir(dir, sizeof dir);
+    tcb_pair_record pairs[3];
+    tcb_cell_result c, back;
+    tcb_error err = {0};
+    make_cell(&c, "anim", "horse", "OUR", 0, 0, pairs);
+    assert_int_equal(tcb_cell_path(path, sizeof path, dir, "anim", "horse", "OUR", 0, &err), 0);
+    assert_int_equal(tcb_cell_save(path, &c, &err), TCB_OK);
+    assert_int_equal(tcb_cell_load(path, &back, &err), TCB_OK);
+    assert_string_equal(back.tcbench_version, TCB_VERSION);
+    tcb_cell_free(&back);
+
+    cJSON *root, *text;
+    assert_int_equal(tcb_json_load(path, &root, &err), TCB_OK);
+    cJSON_ReplaceItemInObject(root, "tcbench_version", cJSON_CreateString("0.0.9"));
+    assert_int_equal(tcb_json_save(path, root, &err), TCB_OK);
+    assert_int_equal(tcb_cell_load(path, &back, &err), TCB_OK);
+    snprintf(again, sizeof again, "%s/again.json", dir);
+    assert_int_equal(tcb_cell_save(again, &back, &err), TCB_OK);
+    tcb_cell_free(&back);
+    assert_int_equal(tcb_cell_load(again, &back, &err), TCB_OK);
+    assert_string_equal(back.tcbench_version, "0.0.9");
+    tcb_cell_free(&back);
+
+    char *json = tcb_binding_cell_json(path, &err);
+    assert_non_null(json);
+    assert_int_equal(tcb_json_parse(json, "binding", &text, &err), TCB_OK);
+    tcb_binding_free(json);
+    assert_true(cJSON_Compare(root, text, 1));
+    cJSON_Delete(text);
+    cJSON_Delete(root);
+    assert_null(tcb_binding_cell_json(dir, &err));
+    tu_remove_tree(dir);
 }
 
 /* ------------------------------------------------------ malformed files */
@@ -373,6 +416,7 @@ int main(void)
         cmocka_unit_test(test_failed_cell_round_trip),
         cmocka_unit_test(test_save_leaves_no_temporaries),
         cmocka_unit_test(test_cell_path_rejects_escapes),
+        cmocka_unit_test(test_version_kept_and_binding_text),
         cmocka_unit_test(test_rejects_missing_key),
         cmocka_unit_test(test_rejects_wrong_type),
         cmocka_unit_test(test_rejects_wrong_format),
