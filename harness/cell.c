@@ -19,7 +19,7 @@ typedef struct eval_bufs {
     int32_t *pred;  /* [nv] predicted vertex ids of frame j */
 } eval_bufs;
 
-static int all_finite(const float *x, size_t n)
+int tcb_all_finite(const float *x, size_t n)
 {
     for (size_t k = 0; k < n; k++)
         if (!isfinite(x[k])) return 0;
@@ -163,7 +163,7 @@ static void reconstruction_cd(const tcb_cell_job *job, void *self, int i, int j,
     } else if (!pts || n <= 0)
         tcb_fail(merr, TCB_ERR_INTERNAL, "reconstruct frame %d (pair %d->%d): returned no points",
                  frame, i, j);
-    else if (!all_finite(pts, (size_t)n * 3))
+    else if (!tcb_all_finite(pts, (size_t)n * 3))
         tcb_fail(merr, TCB_ERR_NUMERIC,
                  "reconstruct frame %d (pair %d->%d): returned a non-finite point", frame, i, j);
     else
@@ -216,7 +216,7 @@ static void eval_pair(const tcb_cell_job *job, void *self, int k, eval_bufs *b,
         tcb_error_prefix(merr, "transfer %d->%d (pair %d): ", i, j, k);
         return;
     }
-    if (!all_finite(b->moved, (size_t)nv * 3)) {
+    if (!tcb_all_finite(b->moved, (size_t)nv * 3)) {
         tcb_fail(merr, TCB_ERR_NUMERIC, "transfer %d->%d (pair %d): returned a non-finite point",
                  i, j, k);
         return;
@@ -364,6 +364,21 @@ int tcb_cell_eval_pair(const tcb_cell_job *job, int k, tcb_pair_capture *out, tc
     int rc = eval_one_pair(job, k, out, err);
     restore_threads(prev);
     return rc;
+}
+
+int tcb_cell_use_method(const tcb_cell_job *job, tcb_method_use use, void *ctx, tcb_error *err)
+{
+    int prev = use_threads(job);
+    tcb_error merr = {0};
+    void *self;
+    int rc = prepare_method(job, &self, NULL, &merr);
+    if (!rc) {
+        rc = use(ctx, self, &merr);
+        if (rc) ensure_error(&merr, rc);
+        job->ops->destroy(self);
+    }
+    restore_threads(prev);
+    return rc ? tcb_fail(err, merr.code, "%s: %s", job->method->label, merr.msg) : TCB_OK;
 }
 
 void tcb_pair_capture_free(tcb_pair_capture *c)

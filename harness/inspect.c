@@ -15,13 +15,7 @@
 #include "tcb/mesh.h"
 #include "tcb/registry.h"
 
-/* Where the options point in the config. */
-typedef struct target {
-    const tcb_dataset_spec *d;
-    const tcb_sequence_spec *s;
-    const tcb_method_spec *m;
-    int seed;
-} target;
+typedef tcb_cell_target target;
 
 /* The cell file's record of the pair, when there is one. */
 typedef struct cell_row {
@@ -29,48 +23,6 @@ typedef struct cell_row {
     tcb_pair_record rec;
     char note[256]; /* why there is none */
 } cell_row;
-
-static int resolve_sequence(const tcb_config *cfg, const char *want, target *t, tcb_error *err)
-{
-    int n = 0;
-    char names[512] = ""; /* for the message; names that do not fit are left out */
-    for (int a = 0; a < cfg->n_datasets; a++)
-        for (int b = 0; b < cfg->datasets[a].n_sequences; b++) {
-            const tcb_dataset_spec *d = &cfg->datasets[a];
-            char name[TCB_PATH_MAX];
-            snprintf(name, sizeof name, "%s/%s", d->name, d->sequences[b].name);
-            size_t used = strlen(names);
-            if (used + strlen(name) + 3 < sizeof names) {
-                if (used) strcat(names, ", ");
-                strcat(names, name);
-            }
-            if (!want || strcmp(want, name) == 0) t->d = d, t->s = &d->sequences[b], n++;
-        }
-    if (n == 1) return TCB_OK;
-    if (want)
-        return tcb_fail(err, TCB_ERR_INPUT, "%s: no sequence '%s' (the run's: %s)", cfg->path,
-                        want, names);
-    return tcb_fail(err, TCB_ERR_INPUT, "%s has %d sequences: choose one with --sequence (%s)",
-                    cfg->path, n, names);
-}
-
-static int resolve(const tcb_config *cfg, const tcb_inspect_opts *o, target *t, tcb_error *err)
-{
-    int rc = resolve_sequence(cfg, o->sequence, t, err);
-    if (rc) return rc;
-    t->m = NULL;
-    for (int k = 0; k < cfg->n_methods; k++)
-        if (strcmp(cfg->methods[k].label, o->method) == 0) t->m = &cfg->methods[k];
-    if (!t->m) return tcb_fail(err, TCB_ERR_INPUT, "%s: no method labelled '%s'", cfg->path, o->method);
-    if (!tcb_registry_find(t->m->method))
-        return tcb_fail(err, TCB_ERR_INPUT, "%s: method '%s' is not registered (a plug-in?)",
-                        cfg->path, t->m->method);
-    t->seed = o->seed >= 0 ? o->seed : t->m->seeds[0];
-    for (int k = 0; k < t->m->n_seeds; k++)
-        if (t->m->seeds[k] == t->seed) return TCB_OK;
-    return tcb_fail(err, TCB_ERR_INPUT, "%s: seed %d is not one of %s's seeds in this run",
-                    cfg->path, t->seed, t->m->label);
-}
 
 static void load_cell_row(const char *run_dir, const target *t, int k, cell_row *row)
 {
@@ -227,11 +179,12 @@ static int write_picture(const char *dir, const tcb_sequence *seq, const tcb_pai
     snprintf(t_mov, sizeof t_mov, "transfer %d -> %d", cap->i, cap->j);
     const float *vi = tcb_seq_frame(seq, cap->i), *vj = tcb_seq_frame(seq, cap->j);
     const tcb_render_panel panels[] = {
-        {t_src, vi, pos}, {t_dst, vj, pos}, {t_mov, vj, moved}, {"error |q_pred - q|", vj, errc}};
+        {t_src, vi, pos, NULL}, {t_dst, vj, pos, NULL}, {t_mov, vj, moved, NULL},
+        {"error |q_pred - q|", vj, errc, NULL}};
     int rc = tcb_path_join(path, sizeof path, err, "%s/pair.png", dir);
     return rc ? rc
               : tcb_render_panels(path, panels, 4, seq->n_verts, seq->faces, seq->n_faces,
-                                  tcb_seq_frame(seq, 0), sqrt(TCB_PCK_MAX), err);
+                                  tcb_seq_frame(seq, 0), seq->n_verts, sqrt(TCB_PCK_MAX), err);
 }
 
 /* Every file of tcb/inspect.h into dir. */
@@ -306,83 +259,49 @@ static void print_account(FILE *out, const target *t, int k, const tcb_pair_capt
             cut, beyond, nv, 100.0 * beyond / nv, worst, cap->pred[worst], verr[worst]);
 }
 
-/* Loads the sequence and split, and evaluates pair *k (resolved from
- * "worst" when < 0) into cap. */
+/* Evaluates pair *k (resolved from "worst" when < 0) of the opened cell
+ * into cap. */
 static int recompute(const tcb_config *cfg, const tcb_inspect_opts *o, const target *t, int *k,
-                     tcb_sequence *seq, tcb_pair_capture *cap, tcb_error *err)
+                     tcb_cell_session *ses, tcb_pair_capture *cap, tcb_error *err)
 {
-    tcb_split split = {0};
-    char split_path[TCB_PATH_MAX], work[TCB_PATH_MAX], ckpt[TCB_PATH_MAX];
     int rc = *k < 0 ? worst_pair(o->run_dir, t, k, err) : TCB_OK;
-    if (!rc) rc = tcb_harness_load_sequence(cfg, t->d, t->s->name, seq, err);
-    if (!rc) rc = tcb_harness_obtain_split(cfg, t->d, t->s, seq, split_path,
-                                           sizeof split_path, &split, err);
-    if (!rc) rc = tcb_harness_work_paths(o->run_dir, t->d->name, t->s->name, t->m->label, t->seed,
-                                         work, ckpt, err);
-    if (!rc) rc = tcb_mkdirs(work, err);
-    if (rc) {
-        tcb_split_free(&split);
-        return rc;
-    }
-    tcb_cell_job job = {
-        .seq = seq,
-        .split = &split,
-        .split_path = split_path,
-        .dataset = t->d,
-        .method = t->m,
-        .ops = tcb_registry_find(t->m->method),
-        .seed = t->seed,
-        .threads = o->threads > 0 ? o->threads : cfg->threads,
-        .reuse_checkpoint = 1,
-        .require_checkpoint = 1,
-        .work_dir = work,
-        .checkpoint = ckpt,
-        .git_revision = "",
-        .reporter = o->reporter,
-    };
-    rc = tcb_cell_eval_pair(&job, *k, cap, err);
-    tcb_split_free(&split);
-    return rc;
+    if (!rc) rc = tcb_cell_session_open(cfg, o->run_dir, t, o->threads, o->reporter, ses, err);
+    return rc ? rc : tcb_cell_eval_pair(&ses->job, *k, cap, err);
 }
 
 int tcb_inspect(const tcb_inspect_opts *o, FILE *out, char *out_path, tcb_error *err)
 {
-    char cfg_path[TCB_PATH_MAX], dir[TCB_PATH_MAX];
+    char dir[TCB_PATH_MAX];
     tcb_config cfg;
-    int rc = tcb_path_join(cfg_path, sizeof cfg_path, err, "%s/config.json", o->run_dir);
+    int rc = tcb_run_config_open(o->run_dir, &cfg, err);
     if (rc) return rc;
-    if (!tcb_is_file(cfg_path))
-        return tcb_fail(err, TCB_ERR_IO, "%s: no such file: %s is not a run directory", cfg_path,
-                        o->run_dir);
-    if ((rc = tcb_config_load(cfg_path, &cfg, err))) return rc;
     target t = {0};
-    tcb_sequence seq = {0};
+    tcb_cell_session ses = {0};
     tcb_pair_capture cap = {0};
     double *verr = NULL;
     int k = o->pair;
-    rc = tcb_harness_load_plugins(&cfg, err);
-    if (!rc) rc = resolve(&cfg, o, &t, err);
-    if (!rc) rc = recompute(&cfg, o, &t, &k, &seq, &cap, err);
+    rc = tcb_cell_target_resolve(&cfg, o->method, o->seed, o->sequence, &t, err);
+    if (!rc) rc = recompute(&cfg, o, &t, &k, &ses, &cap, err);
     if (!rc && o->out_dir) rc = tcb_path_join(dir, sizeof dir, err, "%s", o->out_dir);
     else if (!rc)
         rc = tcb_path_join(dir, sizeof dir, err, "%s/inspect/%s/%s/%s/seed_%d/pair_%d", o->run_dir,
                            t.d->name, t.s->name, t.m->label, t.seed, k);
-    if (!rc && !(verr = malloc((size_t)seq.n_verts * sizeof *verr)))
+    if (!rc && !(verr = malloc((size_t)ses.seq.n_verts * sizeof *verr)))
         rc = tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
     /* Each vertex's error as the metrics compute it (their sL2 is its mean). */
-    if (!rc) rc = tcb_pair_vertex_metrics(tcb_seq_frame(&seq, cap.j), seq.n_verts, cap.pred, verr, NULL, err);
+    if (!rc) rc = tcb_pair_vertex_metrics(tcb_seq_frame(&ses.seq, cap.j), ses.seq.n_verts, cap.pred, verr, NULL, err);
     if (!rc) {
-        for (int v = 0; v < seq.n_verts; v++) verr[v] = sqrt(verr[v]);
+        for (int v = 0; v < ses.seq.n_verts; v++) verr[v] = sqrt(verr[v]);
         cell_row row;
         load_cell_row(o->run_dir, &t, k, &row);
         double diff = row.found ? row_difference(&cap, &row.rec) : 0;
-        rc = write_files(dir, &seq, &t, k, &cap, &row, diff, verr, err);
-        if (!rc) print_account(out, &t, k, &cap, &row, diff, verr, seq.n_verts);
+        rc = write_files(dir, &ses.seq, &t, k, &cap, &row, diff, verr, err);
+        if (!rc) print_account(out, &t, k, &cap, &row, diff, verr, ses.seq.n_verts);
         if (!rc && out_path) snprintf(out_path, TCB_PATH_MAX, "%s", dir);
     }
     free(verr);
     tcb_pair_capture_free(&cap);
-    tcb_sequence_free(&seq);
+    tcb_cell_session_close(&ses);
     tcb_config_free(&cfg);
     return rc;
 }

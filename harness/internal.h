@@ -164,6 +164,49 @@ typedef struct tcb_cell_job {
 int tcb_fit_time_save(const char *checkpoint, double fit_s, tcb_error *err);
 int tcb_fit_time_load(const char *checkpoint, double *fit_s, tcb_error *err);
 
+/* Every x[k], k < n, is finite: what the harness checks of a method's
+ * points before using them. (harness/cell.c) */
+int tcb_all_finite(const float *x, size_t n);
+
+/* A cell of a finished run picked by name, for `tcbench inspect` and
+ * `tcbench frames` (harness/cell_target.c). */
+typedef struct tcb_cell_target {
+    const tcb_dataset_spec *d;
+    const tcb_sequence_spec *s;
+    const tcb_method_spec *m;
+    const tcb_method_ops *ops;
+    int seed;
+} tcb_cell_target;
+
+/* <run_dir>/config.json loaded with its plug-ins; an error names the file
+ * ("... is not a run directory" when there is none). */
+int tcb_run_config_open(const char *run_dir, tcb_config *cfg, tcb_error *err);
+/* The cell of method label `method`, seed (< 0: the method's first) and
+ * sequence "dataset/sequence" (NULL: the config's only one); every name the
+ * config lacks is an error saying what it has. */
+int tcb_cell_target_resolve(const tcb_config *cfg, const char *method, int seed, const char *sequence,
+                            tcb_cell_target *t, tcb_error *err);
+
+/* The target's sequence, split and paths, and a job that reopens its
+ * fitted model (reuse and require the checkpoint: never refit a model that
+ * saves). threads <= 0: the config's. */
+typedef struct tcb_cell_session {
+    tcb_sequence seq;
+    tcb_split split;
+    char split_path[TCB_PATH_MAX], work[TCB_PATH_MAX], ckpt[TCB_PATH_MAX];
+    tcb_cell_job job;
+} tcb_cell_session;
+int tcb_cell_session_open(const tcb_config *cfg, const char *run_dir, const tcb_cell_target *t,
+                          int threads, tcb_reporter reporter, tcb_cell_session *s, tcb_error *err);
+void tcb_cell_session_close(tcb_cell_session *s);
+
+/* Creates job's method and loads (or, for methods without checkpoints,
+ * fits) it with job->threads, hands it to use(ctx, self, merr) and destroys
+ * it. A failure of the method or of `use` is an error prefixed with the
+ * method's label. (harness/cell.c) */
+typedef int (*tcb_method_use)(void *ctx, void *self, tcb_error *merr);
+int tcb_cell_use_method(const tcb_cell_job *job, tcb_method_use use, void *ctx, tcb_error *err);
+
 /* The cell's identity from the job: names, method_impl (ops->name),
  * params, seed, split, git revision, load_s; status ok, empty summary.
  * (harness/cell.c) */

@@ -18,7 +18,8 @@
 enum {
     F_OUT, F_ONLY, F_FORCE, F_QUIET, F_REPORT, F_SEED, F_FRAMES, F_SEQUENCE, F_UPDATE,
     F_PLUGIN, F_THREADS, F_VERBOSE, F_SAMPLES, F_PLOT, F_ROOT, F_VARIANT, F_DRY_RUN, F_REFERENCE, F_CELL,
-    F_SHARD, F_LOCK_TIMEOUT, F_DATASET, F_PRED, F_NAME, F_HELP, F_COUNT
+    F_SHARD, F_LOCK_TIMEOUT, F_DATASET, F_PRED, F_NAME, F_HELP,
+    F_N_FRAMES, F_STYLE, F_COUNT
 };
 #define BIT(f) (1u << (f))
 
@@ -34,7 +35,7 @@ static const struct {
     [F_VARIANT] = {"--variant", 1}, [F_DRY_RUN] = {"--dry-run", 0}, [F_REFERENCE] = {"--reference", 1},
     [F_CELL] = {"--cell", 1},    [F_SHARD] = {"--shard", 1},   [F_LOCK_TIMEOUT] = {"--lock-timeout", 1},
     [F_DATASET] = {"--dataset", 1}, [F_PRED] = {"--pred", 1},  [F_NAME] = {"--name", 1},
-    [F_HELP] = {"--help", 0},
+    [F_HELP] = {"--help", 0},    [F_N_FRAMES] = {"--count", 1}, [F_STYLE] = {"--style", 1},
 };
 
 #define MAX_PLUGINS 64
@@ -366,6 +367,56 @@ static int cmd_inspect(const cli *c)
     return 0;
 }
 
+/* "0,8,16": distinct checks are the library's, which knows the sequence. */
+static int frame_list(const char *s, int *frames, int *n)
+{
+    *n = 0;
+    for (const char *p = s;; p++) {
+        char *end;
+        errno = 0;
+        long v = strtol(p, &end, 10);
+        if (end == p || errno || v < 0 || v > 1000000000 || (*end && *end != ',') || *n == TCB_FRAMES_MAX)
+            return usage_error("frames", "--frames: expected up to %d frame numbers separated by commas, got '%s'",
+                               TCB_FRAMES_MAX, s);
+        frames[(*n)++] = (int)v;
+        if (!*end) return 0;
+        p = end;
+    }
+}
+
+static int frames_style(const char *s, tcb_frames_style *style)
+{
+    static const char *const names[] = {"auto", "texture", "transfer"}; /* tcb_frames_style */
+    for (int k = 0; k < 3; k++)
+        if (strcmp(s ? s : "auto", names[k]) == 0) return *style = (tcb_frames_style)k, 0;
+    return usage_error("frames", "--style: expected auto, texture or transfer, got '%s'", s);
+}
+
+static int cmd_frames(const cli *c)
+{
+    long long seed, threads, count;
+    int frames[TCB_FRAMES_MAX], n = 0;
+    tcb_frames_style style = TCB_FRAMES_AUTO;
+    if (int_option(c, F_SEED, -1, &seed) || int_option(c, F_THREADS, 0, &threads) ||
+        int_option(c, F_N_FRAMES, 0, &count))
+        return 2;
+    if (c->set[F_FRAMES] && c->set[F_N_FRAMES]) return usage_error("frames", "--frames and --count exclude each other");
+    if (c->set[F_FRAMES] && frame_list(c->value[F_FRAMES], frames, &n)) return 2;
+    if (frames_style(c->value[F_STYLE], &style)) return 2;
+    tcb_term_progress tp;
+    tcb_term_progress_init(&tp, stderr, c->set[F_QUIET] ? 1 : -1);
+    tcb_frames_opts o = {c->arg[0], c->arg[1], n ? frames : NULL, n, (int)(count > 1000000 ? 1000000 : count),
+                         (int)(seed > 1000000000 ? -1 : seed), c->value[F_SEQUENCE], c->value[F_OUT],
+                         (int)(threads > 1024 ? 1024 : threads), style, tcb_term_progress_reporter(&tp)};
+    tcb_error err = {0};
+    char dir[TCB_PATH_MAX];
+    int rc = tcb_frames(&o, stdout, dir, &err);
+    tcb_term_progress_finish(&tp);
+    if (rc) return fail(&err);
+    fprintf(stderr, "files: %s/\n", dir);
+    return 0;
+}
+
 static int cmd_score(const cli *c)
 {
     static const struct { int flag; const char *text; } required[] = {
@@ -581,6 +632,38 @@ static const command commands[] = {
      "\n"
      "example:\n"
      "  tcbench inspect runs/atlas-cat mca worst --seed 1\n"},
+    {"frames", cmd_frames,
+     BIT(F_FRAMES) | BIT(F_N_FRAMES) | BIT(F_STYLE) | BIT(F_SEED) | BIT(F_SEQUENCE) | BIT(F_OUT) | BIT(F_THREADS) |
+         BIT(F_QUIET),
+     2, 2, "RUN_DIR METHOD",
+     "usage: tcbench frames RUN_DIR METHOD [--frames F,F,... | --count N] [--style auto|texture|transfer]\n"
+     "                      [--seed S] [--sequence DATASET/SEQUENCE] [--out DIR] [--threads N] [--quiet]\n"
+     "\n"
+     "Draws a few frames of a cell from its fitted model, side by side from one\n"
+     "camera in strip.png. A method that reconstructs a parametrised surface (the\n"
+     "atlas family: atlasnet, dsr, mca) is drawn as its surface of each frame with\n"
+     "one checkerboard in UV space, the same texture in every frame, so a patch that\n"
+     "slides over the body shows it at a glance; the surfaces are also written as\n"
+     "frame_<f>.obj with checker.mtl and checker.png (MeshLab and Blender open them\n"
+     "as they are). Any other method is drawn as its transfer from the first frame:\n"
+     "each frame's GT mesh with every vertex in the colour of the place on the body\n"
+     "the transfer sent it to (frame_<f>.ply), so colours out of place are errors.\n"
+     "\n"
+     "options:\n"
+     "  --frames F,F,...  the frames (at most 16, distinct)\n"
+     "  --count N         N frames evenly spaced from the first to the last (default 5)\n"
+     "  --style S         texture (needs a method with a surface), transfer, or auto\n"
+     "                    (default: texture when the method has one)\n"
+     "  --seed S          the cell's seed (default: the run's first)\n"
+     "  --sequence D/S    dataset/sequence (default: the run's only one)\n"
+     "  --out DIR         where to write (default:\n"
+     "                    RUN_DIR/frames/<dataset>/<sequence>/<method>/seed_<s>)\n"
+     "  --threads N       threads (default: the run's)\n"
+     "  --quiet           no progress output\n"
+     "\n"
+     "examples:\n"
+     "  tcbench frames runs/atlas-cat mca --frames 0,8,16,24\n"
+     "  tcbench frames runs/quick nearest --count 4\n"},
     {"score", cmd_score,
      BIT(F_DATASET) | BIT(F_SEQUENCE) | BIT(F_PRED) | BIT(F_NAME) | BIT(F_SEED) | BIT(F_OUT) | BIT(F_FORCE) |
          BIT(F_ROOT) | BIT(F_VARIANT) | BIT(F_THREADS),
@@ -649,6 +732,7 @@ static const char general_help[] =
     "  datasets  list or export the synthetic sequences, align an OBJ sequence's rotations\n"
     "  check     compare a run with a baseline (CI regression check)\n"
     "  inspect   one evaluation pair as coloured meshes, checked against the run\n"
+    "  frames    a few frames of a cell as a picture: checkerboard-textured surfaces or transfers\n"
     "  score     score correspondences computed elsewhere (.npy files) as a cell of a run\n"
     "  version   print the version\n"
     "  help      help on a command\n"

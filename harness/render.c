@@ -31,10 +31,11 @@ static int by_depth(const void *a, const void *b)
     return (da > db) - (da < db);
 }
 
-static camera make_camera(const tcb_render_panel *panels, int n_panels, int nv, const float *ref)
+static camera make_camera(const tcb_render_panel *panels, int n_panels, int nv, const float *ref,
+                          int n_ref)
 {
     double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
-    for (int k = 0; k < nv; k++)
+    for (int k = 0; k < n_ref; k++)
         for (int a = 0; a < 3; a++) {
             lo[a] = fmin(lo[a], ref[3 * (size_t)k + a]);
             hi[a] = fmax(hi[a], ref[3 * (size_t)k + a]);
@@ -92,8 +93,9 @@ static void draw_mesh(cairo_t *cr, const camera *c, const tcb_render_panel *p,
         double rgb[3] = {0, 0, 0};
         for (int k = 0; k < 3; k++) {
             v[k] = p->verts + 3 * (size_t)t[k];
-            for (int a = 0; a < 3; a++) rgb[a] += p->rgb[3 * (size_t)t[k] + a] / (3 * 255.0);
+            for (int a = 0; a < 3 && !p->face_rgb; a++) rgb[a] += p->rgb[3 * (size_t)t[k] + a] / (3 * 255.0);
         }
+        for (int a = 0; a < 3 && p->face_rgb; a++) rgb[a] = p->face_rgb[3 * (size_t)order[o].face + a] / 255.0;
         double shade = 0.45 + 0.55 * facing(c, v[0], v[1], v[2]);
         cairo_set_source_rgb(cr, shade * rgb[0], shade * rgb[1], shade * rgb[2]);
         for (int k = 0; k < 3; k++) {
@@ -131,12 +133,12 @@ static void draw_colorbar(cairo_t *cr, double max)
 }
 
 int tcb_render_panels(const char *path, const tcb_render_panel *panels, int n_panels, int nv,
-                      const int32_t *faces, int nf, const float *ref, double colorbar_max,
+                      const int32_t *faces, int nf, const float *ref, int n_ref, double colorbar_max,
                       tcb_error *err)
 {
     face_depth *order = malloc((size_t)(nf > 0 ? nf : 1) * sizeof *order);
     if (!order) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory for %d faces", nf);
-    camera c = make_camera(panels, n_panels, nv, ref);
+    camera c = make_camera(panels, n_panels, nv, ref, n_ref);
     cairo_surface_t *surface =
         cairo_image_surface_create(CAIRO_FORMAT_RGB24, PANEL * n_panels, TITLE + PANEL + BAR);
     cairo_t *cr = cairo_create(surface);
@@ -157,6 +159,11 @@ int tcb_render_panels(const char *path, const tcb_render_panel *panels, int n_pa
     }
     free(order);
     cairo_destroy(cr);
+    return tcb_render_save_png(surface, path, err);
+}
+
+int tcb_render_save_png(cairo_surface_t *surface, const char *path, tcb_error *err)
+{
     char tmp[TCB_PATH_MAX];
     int rc = tcb_temp_path_for(path, tmp, sizeof tmp, err);
     cairo_status_t st = cairo_surface_status(surface);

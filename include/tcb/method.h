@@ -27,6 +27,7 @@
 #define TCB_METHOD_H
 
 #include <stdint.h>
+#include <stdlib.h>
 
 #include "tcb/error.h"
 #include "tcb/progress.h"
@@ -37,8 +38,9 @@
 extern "C" {
 #endif
 
-/* 2 added `estimate`; tables of version 1 still load (without it). */
-#define TCB_METHOD_ABI_VERSION 2
+/* 2 added `estimate`, 3 added `surface`; tables of older versions still
+ * load (without them). */
+#define TCB_METHOD_ABI_VERSION 3
 #define TCB_METHOD_ABI_OLDEST 1
 
 typedef struct tcb_fit_ctx {
@@ -81,6 +83,29 @@ typedef struct tcb_cost_estimate {
     char basis[200];        /* "40 000 steps x 63.5 ms (bench_train_step, 1 thread)" */
 } tcb_cost_estimate;
 
+/* A method's surface of one frame as a triangle mesh parametrised by
+ * charts (`surface` below; `tcbench frames` textures it). Each vertex lies
+ * in one chart at (u, v) in [0,1]^2; the harness places chart c's unit
+ * square in cell c of one texture shared by every chart and frame, so the
+ * method never knows the texture and the same (chart, u, v) is the same
+ * texel in every frame: a chart that slides over the body shows it. */
+typedef struct tcb_uv_mesh {
+    int n_verts, n_faces, n_charts;
+    float *verts;    /* [n_verts][3] normalized coordinates, like transfer's */
+    float *uv;       /* [n_verts][2] in [0,1]^2 of the vertex's chart */
+    int32_t *chart;  /* [n_verts] in [0, n_charts) */
+    int32_t *faces;  /* [n_faces][3] vertex ids, counter-clockwise in (u, v);
+                      * a face's three vertices share a chart */
+} tcb_uv_mesh;
+
+/* Frees what a method's `surface` malloc'ed and zeroes *m. */
+static inline void tcb_uv_mesh_free(tcb_uv_mesh *m)
+{
+    free(m->verts), free(m->uv), free(m->chart), free(m->faces);
+    const tcb_uv_mesh none = {0, 0, 0, NULL, NULL, NULL, NULL};
+    *m = none;
+}
+
 typedef struct tcb_method_ops {
     int abi_version;            /* TCB_METHOD_ABI_VERSION */
     const char *name;           /* unique, [a-z0-9_]+ */
@@ -115,6 +140,16 @@ typedef struct tcb_method_ops {
      * >= 2). The compute a cell of this configured method will take, from
      * the method's known step costs; called on a created, unfitted self. */
     void (*estimate)(void *self, const tcb_cost_query *q, tcb_cost_estimate *out);
+
+    /* Optional (NULL: no textured pictures; read only from tables of
+     * abi_version >= 3). The fitted model's surface of `frame` alone (not in
+     * a pair's context), every array malloc'ed and freed by the caller with
+     * tcb_uv_mesh_free. rng is a stream of the frame's own (fresh input
+     * clouds, drawn as the evaluation draws them). The topology (n_verts,
+     * n_faces, faces, chart, uv) must be the same for every frame of a
+     * sequence: only verts move, so one texture and one camera serve all. */
+    int (*surface)(void *self, const tcb_sequence *seq, int frame, tcb_rng *rng, tcb_uv_mesh *out,
+                   tcb_error *err);
 } tcb_method_ops;
 
 typedef const tcb_method_ops *const *(*tcb_plugin_entry_fn)(int *count);

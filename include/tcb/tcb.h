@@ -21,6 +21,7 @@
 #include "tcb/config.h"
 #include "tcb/runner.h"
 #include "tcb/inspect.h"
+#include "tcb/frames.h"
 #include "tcb/npy.h"
 #include "tcb/score.h"
 #include "tcb/report.h"

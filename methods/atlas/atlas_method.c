@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "methods/atlas/eval.h"
+#include "methods/atlas/surface.h"
 #include "methods/atlas/train.h"
 #include "methods/atlas/train_ckpt.h"
 #include "methods/builtin.h"
@@ -177,21 +178,29 @@ static int fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_
     return rc;
 }
 
-/* Evaluates pair (i, j) with fresh input clouds from rng, unless it is the
- * pair evaluated last. */
-static int eval_pair(atlas_method *a, const tcb_sequence *seq, int i, int j, tcb_rng *rng,
-                     tcb_error *err)
+/* A fitted model and frames i, j of seq with point pools to draw from. */
+static int check_frames(const atlas_method *a, const tcb_sequence *seq, int i, int j, tcb_error *err)
 {
     if (!a->model) return tcb_fail(err, TCB_ERR_INTERNAL, "%s: evaluation before fit or load", a->name);
     if (i < 0 || j < 0 || i >= seq->n_frames || j >= seq->n_frames || seq->pool_size < 1 || seq->input_points < 1)
         return tcb_fail(err, TCB_ERR_INPUT, "%s: pair %d->%d outside frames 0..%d or no point pools", a->name, i,
                         j, seq->n_frames - 1);
+    return TCB_OK;
+}
+
+/* Evaluates pair (i, j) with fresh input clouds from rng, unless it is the
+ * pair evaluated last. */
+static int eval_pair(atlas_method *a, const tcb_sequence *seq, int i, int j, tcb_rng *rng,
+                     tcb_error *err)
+{
+    int rc = check_frames(a, seq, i, j, err);
+    if (rc) return rc;
     if (a->pred && a->last_seq == seq && a->last_i == i && a->last_j == j) return TCB_OK;
     forget_pair(a);
     int N = seq->input_points;
     float *clouds = malloc((size_t)2 * N * 3 * sizeof *clouds);
     if (!clouds) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", a->name);
-    int rc = tcb_sequence_draw_points(seq, i, N, seq->draw_with_replacement, rng, clouds, err);
+    rc = tcb_sequence_draw_points(seq, i, N, seq->draw_with_replacement, rng, clouds, err);
     if (!rc) rc = tcb_sequence_draw_points(seq, j, N, seq->draw_with_replacement, rng, clouds + (size_t)N * 3, err);
     if (!rc) rc = tcb_atlas_eval_pair(a->model, &a->eval, clouds, N, &a->pred, &a->n_pred, err);
     free(clouds);
@@ -223,6 +232,26 @@ static int reconstruct(void *self, const tcb_sequence *seq, int i, int j, int fr
     memcpy(*pts, a->pred + (frame == i ? 0 : (size_t)a->n_pred * 3), len);
     *n = a->n_pred;
     return TCB_OK;
+}
+
+/* Every patch, collapsed or not (the evaluation drops collapsed ones from
+ * a pair's points; here a collapsed patch is a sliver the picture shows as
+ * such), on a regular grid decoded for one input cloud of the frame drawn
+ * from rng as the evaluation draws a pair's. */
+static int surface(void *self, const tcb_sequence *seq, int frame, tcb_rng *rng, tcb_uv_mesh *out, tcb_error *err)
+{
+    atlas_method *a = self;
+    const tcb_uv_mesh none = {0, 0, 0, NULL, NULL, NULL, NULL};
+    *out = none;
+    int rc = check_frames(a, seq, frame, frame, err);
+    if (rc) return rc;
+    int N = seq->input_points;
+    float *cloud = malloc((size_t)N * 3 * sizeof *cloud);
+    if (!cloud) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", a->name);
+    rc = tcb_sequence_draw_points(seq, frame, N, seq->draw_with_replacement, rng, cloud, err);
+    if (!rc) rc = tcb_atlas_surface(a->model, cloud, N, TCB_ATLAS_SURFACE_RES, out, err);
+    free(cloud);
+    return rc;
 }
 
 static void destroy(void *self)
@@ -310,7 +339,7 @@ static void estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out
     const tcb_method_ops tcb_method_##id = {                                                                 \
         .abi_version = TCB_METHOD_ABI_VERSION, .name = #id, .description = desc, .create = id##_create,      \
         .fit = fit, .transfer = transfer, .reconstruct = reconstruct, .save = save, .load = load,            \
-        .destroy = destroy, .estimate = estimate,                                                            \
+        .destroy = destroy, .estimate = estimate, .surface = surface,                                        \
     };
 
 ATLAS_METHOD(atlasnet, TCB_ATLAS_LOSS_CHAMFER, "AtlasNet: PointNet + patch decoders, Chamfer loss only")

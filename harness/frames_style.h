@@ -1,0 +1,27 @@
+/* The two styles of `tcbench frames` (tcb/frames.h), each in its own file;
+ * harness/frames.c picks the cell, the frames and the style. Private to
+ * harness/. */
+#ifndef TCB_HARNESS_FRAMES_STYLE_H
+#define TCB_HARNESS_FRAMES_STYLE_H
+
+#include "harness/internal.h"
+#include "tcb/frames.h"
+#include "tcb/rng.h"
+
+typedef struct tcb_frames_job {
+    const tcb_cell_job *cell;  /* the opened cell; its model is reopened per style */
+    const int *frames;         /* [n] distinct, in range */
+    int n;
+    const char *dir;           /* created only once everything is computed */
+} tcb_frames_job;
+
+/* checker.png, checker.mtl, frame_<f>.obj, strip.png (harness/frames_texture.c). */
+int tcb_frames_texture(const tcb_frames_job *f, tcb_error *err);
+/* frame_<f>.ply, strip.png (harness/frames_transfer.c). */
+int tcb_frames_transfer(const tcb_frames_job *f, tcb_error *err);
+
+/* The cell seed's stream "frames/<dataset>/<sequence>/<i>" (j < 0: the
+ * surface of frame i) or ".../<i>/<j>" (transfer i -> j). (harness/frames.c) */
+void tcb_frames_rng(const tcb_cell_job *cell, int i, int j, tcb_rng *rng);
+
+#endif

@@ -1,0 +1,178 @@
+/* `tcbench frames` for a method with `surface`: its reconstruction of each
+ * frame with one checkerboard in UV space (tcb/frames.h). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness/checker.h"
+#include "harness/frames_style.h"
+#include "harness/render.h"
+#include "tcb/fsutil.h"
+
+/* More charts would make the texture larger than viewers like (16 x 16
+ * cells of 256 pixels: 4096 pixels a side). */
+#define MAX_CHARTS 256
+
+typedef struct surfaces {
+    const tcb_frames_job *f;
+    tcb_uv_mesh *mesh; /* [f->n] */
+} surfaces;
+
+static int faces_valid(const tcb_uv_mesh *m)
+{
+    for (size_t k = 0; k < 3 * (size_t)m->n_faces; k++)
+        if (m->faces[k] < 0 || m->faces[k] >= m->n_verts) return 0;
+    for (size_t t = 0; t < (size_t)m->n_faces; t++) {
+        const int32_t *v = m->faces + 3 * t;
+        if (m->chart[v[0]] != m->chart[v[1]] || m->chart[v[0]] != m->chart[v[2]]) return 0;
+    }
+    return 1;
+}
+
+static int charts_valid(const tcb_uv_mesh *m)
+{
+    for (size_t k = 0; k < (size_t)m->n_verts; k++) {
+        float u = m->uv[2 * k], v = m->uv[2 * k + 1];
+        if (m->chart[k] < 0 || m->chart[k] >= m->n_charts || !(u >= 0 && u <= 1 && v >= 0 && v <= 1)) return 0;
+    }
+    return 1;
+}
+
+/* What tcb/method.h promises of a surface, checked before anything uses it. */
+static int check_mesh(const tcb_uv_mesh *m, int frame, tcb_error *merr)
+{
+    if (m->n_verts < 3 || m->n_faces < 1 || m->n_charts < 1 || m->n_charts > MAX_CHARTS || !m->verts ||
+        !m->uv || !m->chart || !m->faces)
+        return tcb_fail(merr, TCB_ERR_INTERNAL,
+                        "surface of frame %d: %d vertices, %d faces, %d charts (1 to %d) or a NULL array", frame,
+                        m->n_verts, m->n_faces, m->n_charts, MAX_CHARTS);
+    if (!tcb_all_finite(m->verts, 3 * (size_t)m->n_verts))
+        return tcb_fail(merr, TCB_ERR_NUMERIC, "surface of frame %d: a non-finite vertex", frame);
+    if (!charts_valid(m))
+        return tcb_fail(merr, TCB_ERR_INTERNAL, "surface of frame %d: a chart id or (u, v) outside its range",
+                        frame);
+    if (!faces_valid(m))
+        return tcb_fail(merr, TCB_ERR_INTERNAL,
+                        "surface of frame %d: a face names a vertex out of range or spans two charts", frame);
+    return TCB_OK;
+}
+
+/* One texture and one face colouring serve all frames only if they agree. */
+static int same_topology(const tcb_uv_mesh *a, const tcb_uv_mesh *b, int fa, int fb, tcb_error *merr)
+{
+    if (a->n_verts == b->n_verts && a->n_faces == b->n_faces && a->n_charts == b->n_charts &&
+        !memcmp(a->faces, b->faces, 3 * (size_t)a->n_faces * sizeof *a->faces) &&
+        !memcmp(a->chart, b->chart, (size_t)a->n_verts * sizeof *a->chart) &&
+        !memcmp(a->uv, b->uv, 2 * (size_t)a->n_verts * sizeof *a->uv))
+        return TCB_OK;
+    return tcb_fail(merr, TCB_ERR_INTERNAL,
+                    "surface of frame %d differs from frame %d's in faces, charts or (u, v) (only vertices may move)",
+                    fb, fa);
+}
+
+static int decode_frames(void *ctx, void *self, tcb_error *merr)
+{
+    surfaces *s = ctx;
+    const tcb_frames_job *f = s->f;
+    for (int k = 0; k < f->n; k++) {
+        tcb_rng rng;
+        tcb_frames_rng(f->cell, f->frames[k], -1, &rng);
+        int rc = f->cell->ops->surface(self, f->cell->seq, f->frames[k], &rng, &s->mesh[k], merr);
+        if (rc) {
+            tcb_error_prefix(merr, "surface of frame %d: ", f->frames[k]);
+            return rc;
+        }
+        if ((rc = check_mesh(&s->mesh[k], f->frames[k], merr))) return rc;
+        if (k && (rc = same_topology(&s->mesh[0], &s->mesh[k], f->frames[0], f->frames[k], merr))) return rc;
+    }
+    return TCB_OK;
+}
+
+static int write_obj(const tcb_frames_job *f, int k, const tcb_uv_mesh *m, const tcb_checker *c, tcb_error *err)
+{
+    char path[TCB_PATH_MAX];
+    tcb_atomic_file af;
+    int rc = tcb_path_join(path, sizeof path, err, "%s/frame_%d.obj", f->dir, f->frames[k]);
+    if (!rc) rc = tcb_atomic_open(&af, path, err);
+    if (rc) return rc;
+    fprintf(af.fp, "# tcbench frames: %s, frame %d, normalized coordinates\nmtllib checker.mtl\n",
+            f->cell->method->label, f->frames[k]);
+    for (size_t v = 0; v < (size_t)m->n_verts; v++)
+        fprintf(af.fp, "v %.7g %.7g %.7g\n", m->verts[3 * v], m->verts[3 * v + 1], m->verts[3 * v + 2]);
+    for (size_t v = 0; v < (size_t)m->n_verts; v++) {
+        float vt[2];
+        tcb_checker_texcoord(c, m->chart[v], m->uv[2 * v], m->uv[2 * v + 1], vt);
+        fprintf(af.fp, "vt %.6f %.6f\n", vt[0], vt[1]);
+    }
+    fprintf(af.fp, "usemtl checker\n");
+    for (size_t t = 0; t < (size_t)m->n_faces; t++) {
+        const int32_t *v = m->faces + 3 * t; /* OBJ counts from 1; vertex v has texture vertex v */
+        fprintf(af.fp, "f %d/%d %d/%d %d/%d\n", v[0] + 1, v[0] + 1, v[1] + 1, v[1] + 1, v[2] + 1, v[2] + 1);
+    }
+    return tcb_atomic_commit(&af, err);
+}
+
+static int write_mtl(const char *dir, tcb_error *err)
+{
+    static const char mtl[] = "# tcbench frames: one checkerboard for every frame\n"
+                              "newmtl checker\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nillum 1\nmap_Kd checker.png\n";
+    char path[TCB_PATH_MAX];
+    int rc = tcb_path_join(path, sizeof path, err, "%s/checker.mtl", dir);
+    return rc ? rc : tcb_write_file_atomic(path, mtl, sizeof mtl - 1, err);
+}
+
+/* Each face in the texture's colour at its UV centroid: the same for every
+ * frame, as the topology is. */
+static void face_colors(const tcb_uv_mesh *m, const tcb_checker *c, uint8_t *rgb)
+{
+    for (size_t t = 0; t < (size_t)m->n_faces; t++) {
+        const int32_t *v = m->faces + 3 * t;
+        double u = 0, w = 0;
+        for (int a = 0; a < 3; a++) u += m->uv[2 * (size_t)v[a]] / 3.0, w += m->uv[2 * (size_t)v[a] + 1] / 3.0;
+        tcb_checker_color(c, m->chart[v[0]], u, w, rgb + 3 * t);
+    }
+}
+
+static int write_strip(const tcb_frames_job *f, const tcb_uv_mesh *mesh, const tcb_checker *c, tcb_error *err)
+{
+    const tcb_uv_mesh *m0 = &mesh[0];
+    tcb_render_panel panels[TCB_FRAMES_MAX];
+    char titles[TCB_FRAMES_MAX][32], path[TCB_PATH_MAX];
+    uint8_t *rgb = malloc(3 * (size_t)m0->n_faces);
+    if (!rgb) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory for %d faces", m0->n_faces);
+    face_colors(m0, c, rgb);
+    for (int k = 0; k < f->n; k++) {
+        snprintf(titles[k], sizeof titles[k], "frame %d", f->frames[k]);
+        panels[k] = (tcb_render_panel){titles[k], mesh[k].verts, NULL, rgb};
+    }
+    const tcb_sequence *seq = f->cell->seq;
+    int rc = tcb_path_join(path, sizeof path, err, "%s/strip.png", f->dir);
+    /* The view axis from the GT's first frame, as every strip and inspect's pair.png. */
+    if (!rc) rc = tcb_render_panels(path, panels, f->n, m0->n_verts, m0->faces, m0->n_faces,
+                                    tcb_seq_frame(seq, 0), seq->n_verts, 0, err);
+    free(rgb);
+    return rc;
+}
+
+static int write_files(const tcb_frames_job *f, const tcb_uv_mesh *mesh, tcb_error *err)
+{
+    tcb_checker c = tcb_checker_layout(mesh[0].n_charts);
+    char path[TCB_PATH_MAX];
+    int rc = tcb_mkdirs(f->dir, err);
+    if (!rc) rc = tcb_path_join(path, sizeof path, err, "%s/checker.png", f->dir);
+    if (!rc) rc = tcb_checker_write_png(&c, path, err);
+    if (!rc) rc = write_mtl(f->dir, err);
+    for (int k = 0; !rc && k < f->n; k++) rc = write_obj(f, k, &mesh[k], &c, err);
+    return rc ? rc : write_strip(f, mesh, &c, err);
+}
+
+int tcb_frames_texture(const tcb_frames_job *f, tcb_error *err)
+{
+    surfaces s = {f, calloc((size_t)f->n, sizeof *s.mesh)};
+    if (!s.mesh) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
+    int rc = tcb_cell_use_method(f->cell, decode_frames, &s, err);
+    if (!rc) rc = write_files(f, s.mesh, err);
+    for (int k = 0; k < f->n; k++) tcb_uv_mesh_free(&s.mesh[k]);
+    free(s.mesh);
+    return rc;
+}
