@@ -4,7 +4,8 @@
  * Linux the child asks for SIGTERM when tcbench dies (PR_SET_PDEATHSIG),
  * so a tcbench killed outright or by Ctrl-C (the command sits in its own
  * process group, out of the terminal's reach) does not leave a training
- * running unseen. Between fork and execve the child makes only
+ * running unseen. (The request follows the thread that forked, which waits
+ * for the command to its end.) Between fork and execve the child makes only
  * async-signal-safe calls (tcbench has other threads): the executable, the
  * environment and the file descriptors are all prepared by the parent.
  *

@@ -2,8 +2,9 @@
  * naming the key), the process runner (exit status and output in the log,
  * a signal, a timeout that ends the whole process group, a command
  * ignoring SIGTERM killed after its grace, a stop request, a command that
- * cannot be found or run, the stop signals tcbench blocks unblocked in the
- * child, the environment's additions), the log's tail in a message, and
+ * cannot be found or run, a tcbench killed outright taking the command
+ * with it, the stop signals tcbench blocks unblocked in the child, the
+ * environment's additions), the log's tail in a message, and
  * the method refusing a transfer it was not told about. */
 #include <stdarg.h>
 #include <stddef.h>
@@ -16,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "methods/builtin.h"
@@ -132,6 +134,35 @@ static void test_timeout_ends_the_group(void **state)
     expect_group_stopped(*state, "sleep 30 & echo $!; wait", 10);
     /* Both ignore SIGTERM: SIGKILL after the grace, not after 30 s. */
     expect_group_stopped(*state, "trap '' TERM; sleep 30 & echo $!; wait; wait", 0.2);
+}
+
+/* A tcbench killed outright (here: a forked test process running the
+ * command) leaves no command behind: the command gets SIGTERM (Linux). */
+static void test_command_ends_with_tcbench(void **state)
+{
+#ifdef __linux__
+    const char *dir = *state;
+    char pidfile[TCB_PATH_MAX], script[3 * TCB_PATH_MAX + 64];
+    snprintf(pidfile, sizeof pidfile, "%s/pid", dir);
+    snprintf(script, sizeof script, "echo $$ > %s.tmp; mv %s.tmp %s; exec sleep 30", pidfile, pidfile, pidfile);
+    pid_t runner = fork();
+    assert_true(runner >= 0);
+    if (runner == 0) {
+        ext_proc_result r;
+        _exit(run_sh(dir, script, 0, 1, &r, NULL) ? 1 : 0);
+    }
+    char *text = NULL;
+    for (int k = 0; k < 1000 && tcb_read_file(pidfile, &text, NULL, NULL); k++) usleep(10000);
+    assert_non_null(text);
+    long command = strtol(text, NULL, 10);
+    free(text);
+    kill(runner, SIGKILL);
+    waitpid(runner, NULL, 0);
+    assert_true(ended_soon(command));
+#else
+    (void)state;
+    skip();
+#endif
 }
 
 static int stop_now(const void *arg)
@@ -252,6 +283,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_exit_status_and_output, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test_setup_teardown(test_timeout_ends_the_group, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test_setup_teardown(test_stop_request, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test_setup_teardown(test_command_ends_with_tcbench, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test_setup_teardown(test_commands_that_cannot_run, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test_setup_teardown(test_child_gets_default_signals, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test_setup_teardown(test_environment_additions, tu_setup_tmpdir, tu_teardown_tmpdir),
