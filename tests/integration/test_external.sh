@@ -8,8 +8,8 @@
 # its grace), a malformed, a missing prediction, a missing reconstruction
 # and a command that does not exist fail the cell with a message naming
 # the file or the command, and leave none of its processes behind; bad
-# params stop the run before it starts. inspect and a resumed run reuse the
-# fit; --force clears the command's model directory. A stop request
+# params stop the run before it starts. inspect, frames and a resumed run
+# reuse the fit; --force clears the command's model directory. A stop request
 # (SIGTERM to tcbench) stops the command gracefully in fit and in transfer,
 # exits 75, and the rerun finishes the cell (without refitting after a
 # stop in transfer). Skipped when /usr/bin/python3 lacks numpy or scipy.
@@ -115,6 +115,15 @@ log=run/work/synth/quadruped_walk/icp/seed_0/external.log
 grep -qF "(agree: " inspect.txt || { cat inspect.txt; exit 1; }
 [ "$(grep -c 'icp_nearest.py fit$' "$log")" -eq 1 ] && [ "$(grep -c 'icp_nearest.py transfer$' "$log")" -eq 2 ] ||
     { echo "FAIL: inspect refitted"; cat "$log"; exit 1; }
+# frames announces its transfers too (one more transfer step, numbered from
+# 0) and draws the skeleton exactly as nearest.
+"$TCBENCH" frames run skeleton --count 4 --out frames_skeleton --quiet > /dev/null
+"$TCBENCH" frames run nearest --count 4 --out frames_nearest --quiet > /dev/null
+for f in frames_nearest/*.ply; do cmp "$f" "frames_skeleton/${f#frames_nearest/}"; done
+log=run/work/synth/quadruped_walk/skeleton/seed_0/external.log
+[ "$(grep -c 'skeleton.py transfer$' "$log")" -eq 2 ] && [ "$(ls run/work/synth/quadruped_walk/skeleton/seed_0/pred)" = "0.npy
+1.npy
+2.npy" ] || { echo "FAIL: frames' transfer step"; cat "$log"; ls run/work/synth/quadruped_walk/skeleton/seed_0/pred; exit 1; }
 # --force empties the work directory, the command's model directory included.
 touch run/work/synth/quadruped_walk/icp/seed_0/model/stale
 "$TCBENCH" run ext.json --only icp --force --quiet
