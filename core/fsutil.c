@@ -50,6 +50,26 @@ int tcb_mkdirs(const char *path, tcb_error *err)
     return TCB_OK;
 }
 
+int tcb_empty_dir(const char *dir, tcb_error *err)
+{
+    DIR *d = opendir(dir);
+    if (!d) return errno == ENOENT ? TCB_OK : tcb_fail(err, TCB_ERR_IO, "%s: cannot list: %s", dir, strerror(errno));
+    int rc = TCB_OK;
+    for (struct dirent *e; !rc && (e = readdir(d));) {
+        char path[TCB_PATH_MAX];
+        struct stat st;
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+        rc = tcb_path_join(path, sizeof path, err, "%s/%s", dir, e->d_name);
+        if (rc) break;
+        int is_dir = lstat(path, &st) == 0 && S_ISDIR(st.st_mode); /* lstat: a link to a directory is a link */
+        if (is_dir) rc = tcb_empty_dir(path, err);
+        if (!rc && (is_dir ? rmdir(path) : unlink(path)) != 0 && errno != ENOENT)
+            rc = tcb_fail(err, TCB_ERR_IO, "%s: cannot remove: %s", path, strerror(errno));
+    }
+    closedir(d);
+    return rc;
+}
+
 /* mkdir -p of the directory part of `path`. */
 static int make_parent(const char *path, tcb_error *err)
 {

@@ -1,5 +1,6 @@
 /* One cell of the grid: create the method, fit it (or reload its
- * checkpoint), transfer and score every evaluation pair of the split.
+ * checkpoint), tell it the pairs when it asks (prepare_pairs, ABI 4),
+ * transfer and score every evaluation pair of the split.
  *
  * Two error channels: `merr` collects the method's failures (and bad output
  * it hands back), which end up in the cell file as status failed/diverged;
@@ -103,6 +104,13 @@ static double reused_fit_time(const tcb_cell_job *job)
     return 0;
 }
 
+/* What fit and prepare_pairs are told; resumed_fit_s may be NULL. */
+static tcb_fit_ctx fit_ctx(const tcb_cell_job *job, double *resumed_fit_s)
+{
+    return (tcb_fit_ctx){(uint64_t)job->seed, job->threads, job->work_dir, job->reporter, resumed_fit_s,
+                         job->interrupted, job->interrupt_arg};
+}
+
 /* create + (load | fit [+ save]); on failure nothing is left to destroy.
  * *fit_s (fit_s may be NULL) gets the whole fit's seconds: this process's,
  * plus what a resumed training or a reused checkpoint cost before. */
@@ -132,8 +140,7 @@ static int prepare_method(const tcb_cell_job *job, void **self, double *fit_s, t
         rc = create_method(job, self, merr);
         if (rc) return rc;
     }
-    tcb_fit_ctx ctx = {(uint64_t)job->seed, job->threads, job->work_dir, job->reporter, &earlier,
-                       job->interrupted, job->interrupt_arg};
+    tcb_fit_ctx ctx = fit_ctx(job, &earlier);
     rc = ops->fit(*self, job->seq, &ctx, merr);
     double spent = earlier + tcb_now_seconds() - t0;
     if (fit_s) *fit_s = spent;
@@ -147,8 +154,29 @@ static int prepare_method(const tcb_cell_job *job, void **self, double *fit_s, t
     return TCB_OK;
 }
 
+int tcb_cell_prepare_pairs(const tcb_cell_job *job, void *self, const int *pairs, int first, int n,
+                           tcb_error *merr)
+{
+    const tcb_method_ops *ops = job->ops;
+    if (ops->abi_version < 4 || !ops->prepare_pairs) return TCB_OK;
+    tcb_fit_ctx ctx = fit_ctx(job, NULL);
+    int rc = ops->prepare_pairs(self, job->seq, pairs, first, n, &ctx, merr);
+    if (!rc) return TCB_OK;
+    ensure_error(merr, rc);
+    tcb_error_prefix(merr, "prepare_pairs %d-%d: ", first, first + n - 1);
+    return rc;
+}
+
+/* The split's pairs first .. first + n - 1, announced. */
+static int prepare_split_pairs(const tcb_cell_job *job, void *self, int first, int n, tcb_error *merr)
+{
+    return tcb_cell_prepare_pairs(job, self, job->split->pairs + 2 * first, first, n, merr);
+}
+
 /* Reconstruct `frame` in the context of pair (i, j) and score it against
- * the frame's GT vertices; the points go to *keep (NULL: freed). */
+ * the frame's GT vertices; the points go to *keep (NULL: freed). A method
+ * of ABI >= 4 may decline (TCB_ERR_UNSUPPORTED): *cd is then NaN, the CD
+ * columns' "-". */
 static void reconstruction_cd(const tcb_cell_job *job, void *self, int i, int j, int frame,
                               tcb_rng *rng, double *cd, float **keep, int *keep_n,
                               tcb_error *merr, tcb_error *herr)
@@ -157,6 +185,12 @@ static void reconstruction_cd(const tcb_cell_job *job, void *self, int i, int j,
     float *pts = NULL;
     int n = 0;
     int rc = job->ops->reconstruct(self, seq, i, j, frame, rng, &pts, &n, merr);
+    if (rc == TCB_ERR_UNSUPPORTED && job->ops->abi_version >= 4) {
+        tcb_error_clear(merr);
+        free(pts);
+        *cd = NAN;
+        return;
+    }
     if (rc) {
         ensure_error(merr, rc);
         tcb_error_prefix(merr, "reconstruct frame %d (pair %d->%d): ", frame, i, j);
@@ -254,6 +288,7 @@ static void evaluate(const tcb_cell_job *job, void *self, tcb_cell_result *c, tc
         tcb_cell_label(label, sizeof label, job->dataset->name, job->seq->name,
                        job->method->label, job->seed);
         tcb_report_progress(&job->reporter, 0, split->n_pairs, label);
+        prepare_split_pairs(job, self, 0, split->n_pairs, merr);
         for (int k = 0; k < split->n_pairs && !merr->code && !herr->code; k++) {
             if (job->interrupted && job->interrupted(job->interrupt_arg)) {
                 tcb_fail(herr, TCB_ERR_INTERRUPTED, "stopped at pair %d of %d of the evaluation (the fitted model is kept)",
@@ -339,8 +374,10 @@ static int eval_one_pair(const tcb_cell_job *job, int k, tcb_pair_capture *out, 
         tcb_pair_record rec;
         tcb_summary sum;
         tcb_summary_init(&sum);
-        eval_pair(job, self, k, &b, &rec, &sum, out, &merr, &herr);
-        out->cd = rec.cd;
+        if (prepare_split_pairs(job, self, k, 1, &merr) == TCB_OK) {
+            eval_pair(job, self, k, &b, &rec, &sum, out, &merr, &herr);
+            out->cd = rec.cd;
+        }
         job->ops->destroy(self);
     }
     out->moved = b.moved, out->pred = b.pred;

@@ -22,21 +22,21 @@ static int transfer_frames(void *ctx, void *self, tcb_error *merr)
     const tcb_frames_job *f = t->f;
     const tcb_sequence *seq = f->cell->seq;
     size_t nv = (size_t)seq->n_verts;
-    int i = f->frames[0];
-    for (int k = 1; k < f->n; k++) {
+    int i = f->frames[0], pairs[2 * TCB_FRAMES_MAX];
+    for (int k = 1; k < f->n; k++) pairs[2 * (k - 1)] = i, pairs[2 * (k - 1) + 1] = f->frames[k];
+    /* A batch method (the external one) computes them all here. */
+    int rc = tcb_cell_prepare_pairs(f->cell, self, pairs, 0, f->n - 1, merr);
+    for (int k = 1; !rc && k < f->n; k++) {
         int j = f->frames[k];
         float *out = t->moved + (size_t)k * nv * 3;
         tcb_rng rng;
         tcb_frames_rng(f->cell, i, j, &rng);
-        int rc = f->cell->ops->transfer(self, seq, i, j, tcb_seq_frame(seq, i), seq->n_verts, out, &rng, merr);
-        if (rc) {
-            tcb_error_prefix(merr, "transfer %d->%d: ", i, j);
-            return rc;
-        }
-        if (!tcb_all_finite(out, nv * 3))
-            return tcb_fail(merr, TCB_ERR_NUMERIC, "transfer %d->%d: returned a non-finite point", i, j);
+        rc = f->cell->ops->transfer(self, seq, i, j, tcb_seq_frame(seq, i), seq->n_verts, out, &rng, merr);
+        if (rc) tcb_error_prefix(merr, "transfer %d->%d: ", i, j);
+        else if (!tcb_all_finite(out, nv * 3))
+            rc = tcb_fail(merr, TCB_ERR_NUMERIC, "transfer %d->%d: returned a non-finite point", i, j);
     }
-    return TCB_OK;
+    return rc;
 }
 
 /* rgb [n][nv][3]: slot 0 the body-place colours, slot k vertex v in the

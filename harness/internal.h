@@ -207,6 +207,14 @@ void tcb_cell_session_close(tcb_cell_session *s);
 typedef int (*tcb_method_use)(void *ctx, void *self, tcb_error *merr);
 int tcb_cell_use_method(const tcb_cell_job *job, tcb_method_use use, void *ctx, tcb_error *err);
 
+/* Tells a method of ABI >= 4 with prepare_pairs the pairs it will
+ * transfer next, in order: pair m, numbered first + m, maps frame
+ * pairs[2m] to pairs[2m + 1] (tcb/method.h). Nothing for other methods.
+ * A failure is in merr, prefixed "prepare_pairs FIRST-LAST: ".
+ * (harness/cell.c) */
+int tcb_cell_prepare_pairs(const tcb_cell_job *job, void *self, const int *pairs, int first, int n,
+                           tcb_error *merr);
+
 /* The cell's identity from the job: names, method_impl (ops->name),
  * params, seed, split, git revision, load_s; status ok, empty summary.
  * (harness/cell.c) */
@@ -261,14 +269,9 @@ int tcb_cell_eval_pair(const tcb_cell_job *job, int k, tcb_pair_capture *out, tc
 void tcb_pair_capture_free(tcb_pair_capture *c);
 
 /* The prediction directory of `tcbench score` (tcb/score.h;
- * harness/score_files.c). check_dir: dir holds 0.npy … <n_pairs-1>.npy and
- * no <k>.npy beyond (the split's path is for the messages).
- * read_prediction: one file on a frame of nv vertices, into pred[nv] (ids;
- * *is_points = 0) or moved[nv][3] (points; *is_points = 1). Errors name the
- * file. */
+ * harness/score_files.c): dir holds 0.npy … <n_pairs-1>.npy and no <k>.npy
+ * beyond (the split's path is for the messages). Errors name the file. */
 int tcb_score_check_dir(const char *dir, int n_pairs, const char *split_path, tcb_error *err);
-int tcb_score_read_prediction(const char *path, int nv, int32_t *pred, float *moved, int *is_points,
-                              tcb_error *err);
 
 /* `tcbench datasets align`: the rotation alignment of an OBJ directory
  * (centred per frame) written as JSON to `out` and, with `plot`, as a PNG

@@ -7,7 +7,6 @@
  * killed run, rerun, produces the same cell files as an uninterrupted one. */
 #include "tcb/runner.h"
 
-#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -42,24 +41,15 @@ static void remove_stale_temps(const char *path)
 }
 
 /* A cell's work directory holds only its method's checkpoints (the model
- * after fit, a training in progress). --force starts the cell from nothing,
- * so it empties the directory; otherwise only killed writers' temporaries
- * go. */
-static void prepare_work_dir(const char *work, int force)
+ * after fit, a training in progress, an external command's own files, in
+ * subdirectories too). --force starts the cell from nothing, so it empties
+ * the directory, and fails when it cannot (a model left there could be
+ * resumed); otherwise only killed writers' temporaries go. */
+static int prepare_work_dir(const char *work, int force, tcb_error *err)
 {
-    if (!force) {
-        tcb_remove_stale_temps(work, "");
-        return;
-    }
-    DIR *d = opendir(work);
-    if (!d) return;
-    for (struct dirent *e; (e = readdir(d));) {
-        char victim[TCB_PATH_MAX];
-        if ((size_t)snprintf(victim, sizeof victim, "%s/%s", work, e->d_name) < sizeof victim &&
-            tcb_is_file(victim))
-            remove(victim);
-    }
-    closedir(d);
+    if (force) return tcb_empty_dir(work, err);
+    tcb_remove_stale_temps(work, "");
+    return TCB_OK;
 }
 
 int tcb_harness_load_plugins(const tcb_config *cfg, tcb_error *err)
@@ -243,8 +233,8 @@ static int run_cell(const run_state *st, const seq_ctx *sc, const tcb_method_spe
     int rc = tcb_harness_work_paths(st->run_dir, sc->dataset->name, sc->seq->name, m->label, seed,
                                     work, ckpt, err);
     if (!rc) rc = tcb_mkdirs(work, err);
+    if (!rc) rc = prepare_work_dir(work, st->opts->force, err);
     if (rc) return rc;
-    prepare_work_dir(work, st->opts->force);
     remove_stale_temps(cell_path);
     tcb_cell_job job = {
         .seq = sc->seq,

@@ -1,5 +1,6 @@
 /* The prediction directory of `tcbench score` (tcb/score.h): which files
- * it must hold, and one file read into vertex ids or points. Every error
+ * it must hold, and one file read into vertex ids or points; and a file of
+ * surface samples (the external method's reconstructions). Every error
  * names the file. */
 #include <dirent.h>
 #include <inttypes.h>
@@ -10,6 +11,7 @@
 
 #include "harness/internal.h"
 #include "tcb/fsutil.h"
+#include "tcb/score.h"
 #include "tcb/nn.h"
 #include "tcb/npy.h"
 
@@ -101,5 +103,29 @@ int tcb_score_read_prediction(const char *path, int nv, int32_t *pred, float *mo
                       shape, nv, nv);
     tcb_npy_free(&a);
     if (rc) tcb_error_prefix(err, "%s: ", path);
+    return rc;
+}
+
+int tcb_score_read_points(const char *path, float **pts, int *n, tcb_error *err)
+{
+    *pts = NULL, *n = 0;
+    tcb_npy a;
+    int rc = tcb_npy_load(path, &a, err); /* its errors name the file */
+    if (rc) return rc;
+    char shape[64];
+    tcb_npy_shape_text(&a, shape, sizeof shape);
+    if (a.ndim != 2 || a.shape[1] != 3 || a.shape[0] < 1 || a.shape[0] > INT_MAX / 3)
+        rc = tcb_fail(err, TCB_ERR_INPUT, "shape %s: expected (M, 3) points, M >= 1", shape);
+    else if (!(*pts = malloc((size_t)a.shape[0] * 3 * sizeof **pts)))
+        rc = tcb_fail(err, TCB_ERR_NOMEM, "out of memory for %s points", shape);
+    else
+        rc = read_points(&a, (int)a.shape[0], *pts, err);
+    if (!rc) *n = (int)a.shape[0];
+    tcb_npy_free(&a);
+    if (rc) {
+        free(*pts);
+        *pts = NULL;
+        tcb_error_prefix(err, "%s: ", path);
+    }
     return rc;
 }

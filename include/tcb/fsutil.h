@@ -50,6 +50,11 @@ int tcb_read_file(const char *path, char **data, size_t *len, tcb_error *err);
 /* mkdir -p. */
 int tcb_mkdirs(const char *path, tcb_error *err);
 
+/* Removes everything below dir, subdirectories included, but not dir
+ * itself; links are removed, never followed. A missing dir is empty.
+ * Errors name the entry that could not be removed. */
+int tcb_empty_dir(const char *dir, tcb_error *err);
+
 int tcb_is_dir(const char *path);
 int tcb_is_file(const char *path);
 

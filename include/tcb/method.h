@@ -6,8 +6,9 @@
  * metrics and all I/O; a method owns only its model.
  *
  * Lifecycle for one (dataset, sequence, method, seed) cell:
- *     create(params_json) → [load(checkpoint) | fit(seq)] → transfer(i, j, …)
- *     × n_pairs → reconstruct(…) × 2 n_pairs (optional) → destroy
+ *     create(params_json) → [load(checkpoint) | fit(seq)] → prepare_pairs
+ *     (optional) → transfer(i, j, …) × n_pairs → reconstruct(…) × 2 n_pairs
+ *     (optional) → destroy
  *
  * Rules:
  *  - Return TCB_OK or an error code with a one-line message in *err.
@@ -20,7 +21,8 @@
  *
  * Out-of-tree plug-ins: a shared object that exports
  *     const tcb_method_ops *const *tcb_plugin_methods(int *count);
- * returning `count` tables with abi_version == TCB_METHOD_ABI_VERSION,
+ * returning `count` tables with abi_version TCB_METHOD_ABI_OLDEST to
+ * TCB_METHOD_ABI_VERSION,
  * loaded with `tcbench --plugin path/to/lib.so …` or the config key
  * "plugins". See docs/adding-a-method.md. */
 #ifndef TCB_METHOD_H
@@ -38,9 +40,11 @@
 extern "C" {
 #endif
 
-/* 2 added `estimate`, 3 added `surface`; tables of older versions still
- * load (without them). */
-#define TCB_METHOD_ABI_VERSION 3
+/* 2 added `estimate`, 3 `surface`, 4 `prepare_pairs` and the reconstruct
+ * that declines (TCB_ERR_UNSUPPORTED); tables of older versions still load,
+ * and the harness reads no member their version did not have (their tables
+ * end before it). */
+#define TCB_METHOD_ABI_VERSION 4
 #define TCB_METHOD_ABI_OLDEST 1
 
 typedef struct tcb_fit_ctx {
@@ -126,7 +130,11 @@ typedef struct tcb_method_ops {
 
     /* Optional (NULL: no reconstruction, "-" in CD columns). Surface samples
      * of `frame` (i or j) in the context of pair (i, j), as evaluated after
-     * transfer(i, j); *pts is malloc'ed [*n][3] and freed by the caller. */
+     * transfer(i, j); *pts is malloc'ed [*n][3] and freed by the caller.
+     * From abi_version 4 it may return TCB_ERR_UNSUPPORTED (*pts NULL): this
+     * configured method has no reconstruction of the pair, whose CD is then
+     * "-"; decline for every pair of a cell or for none (a method whose
+     * params choose whether it reconstructs). */
     int (*reconstruct)(void *self, const tcb_sequence *seq, int i, int j, int frame,
                        tcb_rng *rng, float **pts, int *n, tcb_error *err);
 
@@ -150,6 +158,21 @@ typedef struct tcb_method_ops {
      * sequence: only verts move, so one texture and one camera serve all. */
     int (*surface)(void *self, const tcb_sequence *seq, int frame, tcb_rng *rng, tcb_uv_mesh *out,
                    tcb_error *err);
+
+    /* Optional (NULL: none; read only from tables of abi_version >= 4). The
+     * pairs the harness is about to transfer, told before the first of
+     * them, for a method that computes them in one batch (the external one
+     * runs a process for all of them at once): pair m, numbered first + m,
+     * maps frame pairs[2m] to pairs[2m + 1], m < n. The number is the pair's
+     * index in the split in an evaluation and in inspect (the cell's pairs,
+     * or its one); `tcbench frames` numbers its own pairs from 0. transfer
+     * (and reconstruct) then follow for exactly these pairs, in this order.
+     * ctx is the fit's (seed, threads, work_dir, reporter, stop request;
+     * resumed_fit_s NULL); a stop request may end it with
+     * TCB_ERR_INTERRUPTED, which keeps the fitted model. Its time counts in
+     * the cell's eval_s. */
+    int (*prepare_pairs)(void *self, const tcb_sequence *seq, const int *pairs, int first, int n,
+                         const tcb_fit_ctx *ctx, tcb_error *err);
 } tcb_method_ops;
 
 typedef const tcb_method_ops *const *(*tcb_plugin_entry_fn)(int *count);

@@ -1,4 +1,4 @@
-/* tcbench — reader of NumPy .npy files (the format of numpy.save).
+/* tcbench — reader and writer of NumPy .npy files (the format of numpy.save).
  *
  * The format (numpy.lib.format, versions 1.0, 2.0 and 3.0): the magic
  * "\x93NUMPY", a major and a minor version byte, the header's length
@@ -15,6 +15,8 @@
  * string, complex, half and datetime dtypes. The header is parsed strictly
  * (exactly the three keys; a one-element shape needs its comma, as in
  * Python), and the data must be exactly as long as the shape says.
+ *
+ * tcb_npy_save writes arrays (version 1.0, little-endian, C order).
  *
  * Everything is parsed from a memory buffer, so a fuzzer can drive
  * tcb_npy_parse directly; tcb_npy_load reads a file through it and its
@@ -72,6 +74,21 @@ int tcb_npy_to_double(const tcb_npy *a, double *out, tcb_error *err);
 
 /* "(500, 3)" as numpy prints a shape, into out[size]. */
 void tcb_npy_shape_text(const tcb_npy *a, char *out, size_t size);
+
+/* ---- Writing (core/npy_write.c) --------------------------------------- */
+
+/* What the writer takes: elements in the host's representation. */
+typedef enum tcb_npy_dtype { TCB_NPY_F4, TCB_NPY_F8, TCB_NPY_I4, TCB_NPY_I8 } tcb_npy_dtype;
+
+/* Writes the C-ordered array data[product of shape] as path, atomically
+ * (tcb/fsutil.h: a killed writer leaves no partial file), in the one form
+ * every .npy reader takes: format version 1.0, little-endian ('<f4', '<f8',
+ * '<i4', '<i8'), C order, the header padded as numpy pads it (the data
+ * start at a multiple of 64 bytes), so the file is byte for byte what
+ * numpy.save writes for the same array. ndim is 0 (a scalar) to
+ * TCB_NPY_MAX_DIMS. Errors name the file. */
+int tcb_npy_save(const char *path, tcb_npy_dtype dtype, int ndim, const uint64_t *shape, const void *data,
+                 tcb_error *err);
 
 #ifdef __cplusplus
 }

@@ -54,6 +54,17 @@ typedef struct tcb_score_opts {
 int tcb_score(const tcb_config *cfg, const tcb_score_opts *o, char *cell_path, tcb_summary *summary,
               tcb_error *err);
 
+/* The file readers `tcbench score` and the external method (whose command
+ * writes this format) share (harness/score_files.c); errors name the file.
+ * read_prediction: one pair's file, on a frame of nv vertices, into
+ * pred[nv] (vertex ids; *is_points = 0) or moved[nv][3] (points;
+ * *is_points = 1). read_points: surface samples, shape (M, 3) float32 or
+ * float64, M >= 1, finite, into *pts (malloc'ed [*n][3], float64 rounded
+ * to float32 as above). */
+int tcb_score_read_prediction(const char *path, int nv, int32_t *pred, float *moved, int *is_points,
+                              tcb_error *err);
+int tcb_score_read_points(const char *path, float **pts, int *n, tcb_error *err);
+
 #ifdef __cplusplus
 }
 #endif

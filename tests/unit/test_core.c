@@ -1,4 +1,5 @@
-/* core/: errors, random streams, atomic files, JSON getters, progress. */
+/* core/: errors, random streams, atomic files, emptying a directory, JSON
+ * getters, progress. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -10,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "testutil.h"
 #include "tcb/error.h"
@@ -153,6 +155,32 @@ static void test_stale_temps_only(void **state)
     assert_int_equal(tcb_atomic_commit(&af, &err), TCB_OK);
 }
 
+/* Everything below the directory goes, subdirectories too; a link goes,
+ * never what it points to; a missing directory is empty. */
+static void test_empty_dir(void **state)
+{
+    const char *dir = *state;
+    char work[TCB_PATH_MAX], deep[TCB_PATH_MAX], outside[TCB_PATH_MAX], file[TCB_PATH_MAX], link[TCB_PATH_MAX];
+    tcb_error err = {0};
+    snprintf(work, sizeof work, "%s/work", dir);
+    snprintf(deep, sizeof deep, "%s/work/model/a/b", dir);
+    snprintf(outside, sizeof outside, "%s/outside", dir);
+    assert_int_equal(tcb_mkdirs(deep, &err), TCB_OK);
+    assert_int_equal(tcb_mkdirs(outside, &err), TCB_OK);
+    tu_write_text(deep, "ckpt", "x", file, sizeof file);
+    tu_write_text(work, "model.ckpt", "x", file, sizeof file);
+    tu_write_text(outside, "kept", "x", file, sizeof file);
+    snprintf(link, sizeof link, "%s/work/model/to_outside", dir);
+    assert_int_equal(symlink(outside, link), 0);
+    assert_int_equal(tcb_empty_dir(work, &err), TCB_OK);
+    assert_true(tcb_is_dir(work));
+    assert_int_equal(count_entries(work), 0);
+    assert_true(tcb_is_file(file));
+    assert_int_equal(count_entries(outside), 1);
+    snprintf(work, sizeof work, "%s/missing", dir);
+    assert_int_equal(tcb_empty_dir(work, &err), TCB_OK);
+}
+
 static void test_path_join_refuses_truncation(void **state)
 {
     (void)state;
@@ -241,6 +269,7 @@ int main(void)
         cmocka_unit_test(test_rng_distributions),
         cmocka_unit_test(test_atomic_write_commit_and_abort),
         cmocka_unit_test_setup_teardown(test_stale_temps_only, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test_setup_teardown(test_empty_dir, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test(test_path_join_refuses_truncation),
         cmocka_unit_test(test_json_errors_name_the_key),
         cmocka_unit_test(test_progress_plain_lines_when_not_a_tty),
