@@ -138,21 +138,41 @@ static int probed(int i, int n_sources)
     return (long long)(p * n_sources / PROBE_SOURCES) == i;
 }
 
+/* Queries of source s that are A* searches (landmarks can speed them up);
+ * a crowded source's are one Dijkstra, which they cannot. */
+static int astar_queries(const query_groups *q, int32_t s)
+{
+    int m = q->first[s + 1] - q->first[s];
+    return m <= PER_TARGET_MAX ? m : 0;
+}
+
+/* What the probe saw of the A* searches, and what is left of them. */
+typedef struct probe_result {
+    long long expanded;   /* vertices its A* searches expanded */
+    int queries;          /* its A* queries */
+    int queries_left;     /* A* queries of the sources it left */
+} probe_result;
+
 /* The probe, on this thread: its sources answered with the straight-line
- * bound; *expanded the vertices that took. 0, or answer_source's error. */
+ * bound. 0, or answer_source's error. */
 static int run_probe(const tcb_geo_view *gv, const query_groups *q, double *dist,
-                     long long *expanded, int *n_probed)
+                     probe_result *out)
 {
     tcb_geo_ws ws;
     if (tcb_geo_ws_init(&ws, gv->g->n_verts)) return -1;
     int rc = 0;
-    *n_probed = 0;
-    for (int i = 0; i < q->n_sources && !rc; i++)
-        if (probed(i, q->n_sources)) {
-            rc = answer_source(gv, &ws, q, q->sources[i], dist);
-            ++*n_probed;
+    *out = (probe_result){0, 0, 0};
+    for (int i = 0; i < q->n_sources && !rc; i++) {
+        int32_t s = q->sources[i];
+        if (!probed(i, q->n_sources)) {
+            out->queries_left += astar_queries(q, s);
+            continue;
         }
-    *expanded = ws.expanded;
+        long long before = ws.expanded;
+        rc = answer_source(gv, &ws, q, s, dist);
+        if (astar_queries(q, s)) out->expanded += ws.expanded - before;
+        out->queries += astar_queries(q, s);
+    }
     tcb_geo_ws_free(&ws);
     return rc;
 }
@@ -177,17 +197,18 @@ static int answer_rest(const tcb_geo_view *gv, const query_groups *q, double *di
     return failed;
 }
 
-/* Probe, decide on landmarks, answer the rest; 0, 2 (out of memory) or 1. */
+/* Probe, decide on landmarks, answer the rest; 0, 2 (out of memory) or 1.
+ * Landmarks are built when the A* searches left, at the probe's rate,
+ * would expand more vertices than building them does (one full Dijkstra
+ * per landmark). */
 static int answer_all(tcb_geo_view *gv, const query_groups *q, double *dist)
 {
-    long long expanded;
-    int n_probed;
-    int rc = run_probe(gv, q, dist, &expanded, &n_probed);
+    probe_result p;
+    int rc = run_probe(gv, q, dist, &p);
     if (rc) return rc < 0 ? 2 : 1;
-    int rest = q->n_sources - n_probed;
-    if (rest == 0) return 0;
+    if (q->n_sources <= PROBE_SOURCES) return 0;
     double *lm = NULL;
-    double expected = (double)expanded * rest / n_probed;
+    double expected = p.queries ? (double)p.expanded * p.queries_left / p.queries : 0.0;
     if (expected > (double)TCB_GEO_LANDMARKS * gv->g->n_verts &&
         tcb_geo_landmarks(gv, &lm, &gv->lm_slack))
         return 2;

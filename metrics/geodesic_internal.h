@@ -15,8 +15,7 @@
 #define TCB_GEO_LANDMARKS 16
 
 typedef struct tcb_geo_heap_entry {
-    double f;   /* g + h: the order */
-    double g;   /* distance when pushed: stale once the vertex has a smaller one */
+    double f;   /* g + h when pushed: stale once above the vertex's g + h */
     int32_t v;
 } tcb_geo_heap_entry;
 

@@ -23,11 +23,11 @@ typedef struct fixture {
 } fixture;
 
 static const fake_cell CELLS[] = {
-    {"anim", "cat", "validation", "AN", 0, TCB_CELL_OK, 0.03, 1},
-    {"anim", "horse", "test", "AN", 0, TCB_CELL_OK, 0.01, 1},
-    {"anim", "horse", "test", "AN", 1, TCB_CELL_OK, 0.01, 1},
-    {"anim", "horse", "test", "NN", 0, TCB_CELL_OK, 0.02, 0},
-    {"anim", "horse", "test", "DSR", 0, TCB_CELL_DIVERGED, 0.01, 1},
+    {"anim", "cat", "validation", "AN", 0, TCB_CELL_OK, 0.03, 1, 0},
+    {"anim", "horse", "test", "AN", 0, TCB_CELL_OK, 0.01, 1, 0},
+    {"anim", "horse", "test", "AN", 1, TCB_CELL_OK, 0.01, 1, 0},
+    {"anim", "horse", "test", "NN", 0, TCB_CELL_OK, 0.02, 0, 0},
+    {"anim", "horse", "test", "DSR", 0, TCB_CELL_DIVERGED, 0.01, 1, 0},
 };
 #define N_CELLS ((int)(sizeof CELLS / sizeof CELLS[0]))
 
@@ -261,6 +261,66 @@ static void test_missing_and_extra_rows_drift(void **state)
     assert_int_equal(fake_write(f->dir, &CELLS[0]), 0);
 }
 
+/* The geodesic error drifts like any metric. */
+static void geo_moves(cJSON *root, cJSON *row)
+{
+    (void)root;
+    cJSON *v = cJSON_GetObjectItem(row, "geo");
+    cJSON_SetNumberValue(v, v->valuedouble + 1e-3);
+}
+
+/* A baseline written before the geodesic error: no geodesic values, no
+ * geodesic tolerances. */
+static void strip_geodesic(cJSON *root, cJSON *row)
+{
+    (void)row;
+    cJSON *t = cJSON_GetObjectItem(root, "tolerances"), *r;
+    cJSON_DeleteItemFromObject(t, "geo");
+    cJSON_DeleteItemFromObject(t, "geo_auc");
+    cJSON_ArrayForEach(r, cJSON_GetObjectItem(root, "rows"))
+    {
+        cJSON_DeleteItemFromObject(r, "geo");
+        cJSON_DeleteItemFromObject(r, "geo_auc");
+    }
+}
+
+static int count(const char *text, const char *needle)
+{
+    int n = 0;
+    for (const char *p = text; (p = strstr(p, needle)); p++) n++;
+    return n;
+}
+
+static void test_geodesic(void **state)
+{
+    fixture *f = *state;
+    char path[2048], *table, lines[8][256];
+    edited(f, "horse", "AN", geo_moves, "geo.json", path, sizeof path);
+    assert_int_equal(check(f, path, &table), 1);
+    assert_int_equal(drift_lines(table, lines, 8), 1);
+    assert_non_null(strstr(lines[0], " geo "));
+    free(table);
+    /* An old baseline still checks the paper's metrics, lists the
+     * geodesic ones as unchecked and finds no drift; it still catches a
+     * moved m_sL2. */
+    edited(f, "horse", "AN", strip_geodesic, "old.json", path, sizeof path);
+    assert_int_equal(check(f, path, &table), 0);
+    assert_int_equal(count(table, "unchecked"), 2 * 3); /* geo, geo_auc of the 3 ok rows */
+    assert_non_null(strstr(table, " sl2 "));
+    free(table);
+    /* A run whose cell has no geodesic values (written before them) drifts
+     * against a baseline that has them. */
+    fake_cell old = CELLS[1];
+    old.no_geo = 1;
+    assert_int_equal(fake_write(f->dir, &old), 0);
+    assert_int_equal(check(f, f->baseline, &table), 1);
+    assert_int_equal(drift_lines(table, lines, 8), 2);
+    assert_non_null(strstr(lines[0], " geo "));
+    assert_non_null(strstr(lines[1], " geo_auc "));
+    free(table);
+    assert_int_equal(fake_write(f->dir, &CELLS[1]), 0);
+}
+
 static void expect_malformed(const fixture *f, const char *text, const char *key)
 {
     char path[2048];
@@ -315,6 +375,7 @@ int main(void)
         cmocka_unit_test(test_row_tolerance),
         cmocka_unit_test(test_null_and_status_mismatch_drift),
         cmocka_unit_test(test_missing_and_extra_rows_drift),
+        cmocka_unit_test(test_geodesic),
         cmocka_unit_test(test_malformed_baselines),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
