@@ -116,10 +116,23 @@ static void test_baseline_checks_clean(void **state)
     free(table);
 }
 
-static void shift(cJSON *row, double by)
+static void shift_metric(cJSON *row, const char *metric, double by)
 {
-    cJSON *v = cJSON_GetObjectItem(row, "sl2");
+    cJSON *v = cJSON_GetObjectItem(row, metric);
     cJSON_SetNumberValue(v, v->valuedouble + by);
+}
+static void shift(cJSON *row, double by) { shift_metric(row, "sl2", by); }
+
+/* Checks the baseline at path: exactly one row drifts, on one line, which
+ * contains every one of the n needles. */
+static void expect_one_drift(const fixture *f, const char *path, int n, const char *const *needles)
+{
+    char *table, lines[8][256];
+    assert_int_equal(check(f, path, &table), 1);
+    assert_int_equal(drift_lines(table, lines, 8), 1);
+    for (int k = 0; k < n; k++)
+        if (!strstr(lines[0], needles[k])) fail_msg("no \"%s\" in: %s", needles[k], lines[0]);
+    free(table);
 }
 static void beyond_tolerance(cJSON *root, cJSON *row) { (void)root, shift(row, 1e-3); }
 static void within_tolerance(cJSON *root, cJSON *row) { (void)root, shift(row, 5e-7); }
@@ -127,14 +140,9 @@ static void within_tolerance(cJSON *root, cJSON *row) { (void)root, shift(row, 5
 static void test_drift_beyond_tolerance(void **state)
 {
     fixture *f = *state;
-    char path[2048], *table, lines[8][256];
+    char path[2048], *table;
     edited(f, "horse", "AN", beyond_tolerance, "beyond.json", path, sizeof path);
-    assert_int_equal(check(f, path, &table), 1);
-    assert_int_equal(drift_lines(table, lines, 8), 1);
-    assert_non_null(strstr(lines[0], "anim/horse/AN "));
-    assert_non_null(strstr(lines[0], " sl2 "));
-    assert_non_null(strstr(lines[0], "-1.000e-03"));
-    free(table);
+    expect_one_drift(f, path, 3, (const char *const[]){"anim/horse/AN ", " sl2 ", "-1.000e-03"});
     edited(f, "horse", "AN", within_tolerance, "within.json", path, sizeof path);
     assert_int_equal(check(f, path, &table), 0);
     free(table);
@@ -262,12 +270,7 @@ static void test_missing_and_extra_rows_drift(void **state)
 }
 
 /* The geodesic error drifts like any metric. */
-static void geo_moves(cJSON *root, cJSON *row)
-{
-    (void)root;
-    cJSON *v = cJSON_GetObjectItem(row, "geo");
-    cJSON_SetNumberValue(v, v->valuedouble + 1e-3);
-}
+static void geo_moves(cJSON *root, cJSON *row) { (void)root, shift_metric(row, "geo", 1e-3); }
 
 /* A baseline written before the geodesic error: no geodesic values, no
  * geodesic tolerances. */
@@ -283,6 +286,11 @@ static void strip_geodesic(cJSON *root, cJSON *row)
         cJSON_DeleteItemFromObject(r, "geo_auc");
     }
 }
+static void strip_geodesic_and_shift(cJSON *root, cJSON *row)
+{
+    strip_geodesic(root, row);
+    shift(row, 1e-3);
+}
 
 static int count(const char *text, const char *needle)
 {
@@ -296,10 +304,7 @@ static void test_geodesic(void **state)
     fixture *f = *state;
     char path[2048], *table, lines[8][256];
     edited(f, "horse", "AN", geo_moves, "geo.json", path, sizeof path);
-    assert_int_equal(check(f, path, &table), 1);
-    assert_int_equal(drift_lines(table, lines, 8), 1);
-    assert_non_null(strstr(lines[0], " geo "));
-    free(table);
+    expect_one_drift(f, path, 2, (const char *const[]){"anim/horse/AN ", " geo "});
     /* An old baseline still checks the paper's metrics, lists the
      * geodesic ones as unchecked and finds no drift; it still catches a
      * moved m_sL2. */
@@ -308,6 +313,8 @@ static void test_geodesic(void **state)
     assert_int_equal(count(table, "unchecked"), 2 * 3); /* geo, geo_auc of the 3 ok rows */
     assert_non_null(strstr(table, " sl2 "));
     free(table);
+    edited(f, "horse", "AN", strip_geodesic_and_shift, "old_moved.json", path, sizeof path);
+    expect_one_drift(f, path, 2, (const char *const[]){"anim/horse/AN ", " sl2 "});
     /* A run whose cell has no geodesic values (written before them) drifts
      * against a baseline that has them. */
     fake_cell old = CELLS[1];
