@@ -98,6 +98,10 @@ int tcb_edge_graph_build(const int32_t *faces, int nf, int nv, tcb_edge_graph *o
     fill_rows(faces, nf, out, scratch);
     label_components(out, scratch);
     free(scratch);
+    /* Give back the room the repeated sides took (half of it on a closed
+     * mesh); a failed shrink keeps the larger block, which is as good. */
+    int32_t *fit = realloc(out->adj, ((size_t)2 * out->n_edges + 1) * sizeof *fit);
+    if (fit) out->adj = fit;
     return TCB_OK;
 }
 

@@ -45,11 +45,13 @@
  * the pair alone: results do not depend on the thread count. Measured by
  * bench/geodesic.c (docs/protocol.md quotes it).
  *
- * Memory. The graph's topology is built once per sequence (every frame
- * shares the faces): 4(2·nv + 2·n_edges) bytes. The edge lengths of a frame
- * are recomputed per pair (8 bytes per directed edge) rather than kept per
- * frame: that costs one sqrt per edge, far less than the searches, and
- * keeps DFAUST's thousands of frames out of memory. */
+ * Memory. The graph's topology serves every frame (they share the faces),
+ * so the harness builds it once per cell: about 4(2·nv + 2·n_edges) bytes.
+ * The edge lengths of a frame are recomputed per pair (8 bytes per
+ * directed edge) rather than kept per frame: that costs one sqrt per edge,
+ * far less than the searches, and keeps DFAUST's thousands of frames out of
+ * memory. A pair that builds landmarks holds 16 doubles per vertex while it
+ * is scored. */
 #ifndef TCB_GEODESIC_H
 #define TCB_GEODESIC_H
 
