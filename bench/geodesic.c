@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "bench_util.h"
+#include "tests/support/bent_tube.h"
 #include "tcb/geodesic.h"
 #include "tcb/geometry.h"
 #include "tcb/mesh.h"
@@ -41,49 +42,18 @@ typedef struct frames {
 
 /* ---- the synthetic U ----------------------------------------------- */
 
-/* A point of the ellipsoid (radius r, length len along y) bent so its axis
- * is an arc of angle theta. */
-static void bent_point(double r, double len, double theta, double alpha, double beta, float *out)
-{
-    double x = r * sin(alpha) * cos(beta), y = 0.5 * len * cos(alpha), z = r * sin(alpha) * sin(beta);
-    double rho = len / theta, phi = y / rho;
-    out[0] = (float)(rho * (1 - cos(phi)) + x * cos(phi));
-    out[1] = (float)(rho * sin(phi) - x * sin(phi));
-    out[2] = (float)z;
-}
-
-/* 2 poles + rings × segs vertices; both frames share the faces. */
+/* 2 poles + rings × segs vertices, length 8, radius 1 (tests/support/
+ * bent_tube.h); frame i bent to 0.8π, frame j to π; both share the faces. */
 static void synth_u(frames *f, int rings, int segs)
 {
-    const double r = 1.0, len = 8.0;
-    f->nv = 2 + rings * segs;
-    f->nf = 2 * segs * rings;
+    f->nv = bent_tube_verts(rings, segs);
+    f->nf = bent_tube_faces(rings, segs);
     f->vi = malloc((size_t)f->nv * 3 * sizeof(float));
     f->vj = malloc((size_t)f->nv * 3 * sizeof(float));
     f->faces = malloc((size_t)f->nf * 3 * sizeof(int32_t));
     if (!f->vi || !f->vj || !f->faces) bench_die(PROG, "out of memory");
-    for (int fr = 0; fr < 2; fr++) {
-        float *v = fr ? f->vj : f->vi;
-        double theta = fr ? M_PI : 0.8 * M_PI;
-        bent_point(r, len, theta, 0, 0, v);
-        bent_point(r, len, theta, M_PI, 0, v + 3);
-        for (int a = 0; a < rings; a++)
-            for (int b = 0; b < segs; b++)
-                bent_point(r, len, theta, M_PI * (a + 1) / (rings + 1), 2 * M_PI * b / segs,
-                           v + 3 * (2 + (size_t)a * segs + b));
-    }
-    int32_t *t = f->faces;
-#define RING(a, b) (2 + (a) * segs + ((b) % segs))
-    for (int b = 0; b < segs; b++) {
-        *t++ = 0, *t++ = RING(0, b + 1), *t++ = RING(0, b);
-        *t++ = 1, *t++ = RING(rings - 1, b), *t++ = RING(rings - 1, b + 1);
-    }
-    for (int a = 0; a + 1 < rings; a++)
-        for (int b = 0; b < segs; b++) {
-            *t++ = RING(a, b), *t++ = RING(a, b + 1), *t++ = RING(a + 1, b);
-            *t++ = RING(a + 1, b), *t++ = RING(a, b + 1), *t++ = RING(a + 1, b + 1);
-        }
-#undef RING
+    bent_tube(rings, segs, 8.0, 0.8 * M_PI, 0.0, 1, f->vi, f->faces);
+    bent_tube(rings, segs, 8.0, M_PI, 0.0, 1, f->vj, f->faces);
 }
 
 /* ---- the real crane ------------------------------------------------- */

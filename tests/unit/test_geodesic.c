@@ -18,6 +18,7 @@
 #include "tcb/geodesic.h"
 #include "tcb/geometry.h"
 #include "tcb/rng.h"
+#include "bent_tube.h"
 #include "testutil.h"
 
 #define REL 1e-12
@@ -63,38 +64,14 @@ static mesh grid(int nx, int ny, float h, double jitter, uint64_t seed)
     return m;
 }
 
-/* A closed tube of `rings` × `segs` vertices plus two poles; its axis
- * bends by `bend` radians (a U at π) and its radius wobbles by `bump`. */
+/* A closed tube (bent_tube.h): bent by `bend` radians (a U at π), its
+ * radius wobbling by `bump`. */
 static mesh tube(int rings, int segs, double bend, double bump, uint64_t seed)
 {
-    mesh m = {2 + rings * segs, 2 * segs * rings, NULL, NULL};
+    mesh m = {bent_tube_verts(rings, segs), bent_tube_faces(rings, segs), NULL, NULL};
     m.v = malloc((size_t)m.nv * 3 * sizeof *m.v);
     m.f = malloc((size_t)m.nf * 3 * sizeof *m.f);
-    tcb_rng rng;
-    tcb_rng_seed(&rng, seed);
-    const double len = 6.0;
-    for (int k = 0; k < m.nv; k++) {
-        double alpha = k == 0 ? 0 : k == 1 ? M_PI : M_PI * ((k - 2) / segs + 1) / (rings + 1);
-        double beta = k < 2 ? 0 : 2 * M_PI * ((k - 2) % segs) / segs;
-        double r = 1.0 + bump * (tcb_rng_uniform(&rng) - 0.5);
-        double x = r * sin(alpha) * cos(beta), y = 0.5 * len * cos(alpha), z = r * sin(alpha) * sin(beta);
-        double rho = len / bend, phi = y / rho;
-        m.v[3 * k] = (float)(rho * (1 - cos(phi)) + x * cos(phi));
-        m.v[3 * k + 1] = (float)(rho * sin(phi) - x * sin(phi));
-        m.v[3 * k + 2] = (float)z;
-    }
-    int32_t *t = m.f;
-#define RING(a, b) (2 + (a) * segs + ((b) % segs))
-    for (int b = 0; b < segs; b++) {
-        *t++ = 0, *t++ = RING(0, b + 1), *t++ = RING(0, b);
-        *t++ = 1, *t++ = RING(rings - 1, b), *t++ = RING(rings - 1, b + 1);
-    }
-    for (int a = 0; a + 1 < rings; a++)
-        for (int b = 0; b < segs; b++) {
-            *t++ = RING(a, b), *t++ = RING(a, b + 1), *t++ = RING(a + 1, b);
-            *t++ = RING(a + 1, b), *t++ = RING(a, b + 1), *t++ = RING(a + 1, b + 1);
-        }
-#undef RING
+    bent_tube(rings, segs, 6.0, bend, bump, seed, m.v, m.f);
     return m;
 }
 
