@@ -38,8 +38,8 @@
  * answers each by A* towards it, one with many (a method mapping many
  * vertices to one) by a single Dijkstra that stops once they are all
  * settled. A* is guided by the straight-line distance and, when a probe
- * of the pair's first searches says the queries are long (a bad method),
- * also by landmark distances (ALT), which follow the surface. Both bounds
+ * (32 sources spread over the pair's) says the queries are long (a bad
+ * method), also by landmark distances (ALT), which follow the surface. Both bounds
  * are admissible, so every distance is Dijkstra's. Sources run in
  * parallel (OpenMP), each query independent, and every choice depends on
  * the pair alone: results do not depend on the thread count. Measured by
