@@ -14,11 +14,39 @@
 #include "tcb/fsutil.h"
 #include "tcb/metrics.h"
 
-/* Per-pair scratch, sized for the sequence once per cell. */
+/* Per-pair scratch, sized for the sequence once per cell, and the scorer
+ * (the edge graph of the faces, for the geodesic error), also made once. */
 typedef struct eval_bufs {
     float *moved;   /* [nv][3] transfer output on frame j */
     int32_t *pred;  /* [nv] predicted vertex ids of frame j */
+    double *geo;    /* [nv] each vertex's normalised geodesic error */
+    tcb_pair_scorer scorer;
 } eval_bufs;
+
+static void eval_bufs_free(eval_bufs *b)
+{
+    free(b->moved);
+    free(b->pred);
+    free(b->geo);
+    tcb_pair_scorer_free(&b->scorer);
+    memset(b, 0, sizeof *b);
+}
+
+static int eval_bufs_init(const tcb_sequence *seq, eval_bufs *b, tcb_error *herr)
+{
+    size_t nv = (size_t)seq->n_verts;
+    memset(b, 0, sizeof *b);
+    b->moved = malloc(nv * 3 * sizeof *b->moved);
+    b->pred = malloc(nv * sizeof *b->pred);
+    b->geo = malloc(nv * sizeof *b->geo);
+    if (!b->moved || !b->pred || !b->geo) {
+        eval_bufs_free(b);
+        return tcb_fail(herr, TCB_ERR_NOMEM, "out of memory for %zu vertices", nv);
+    }
+    int rc = tcb_pair_scorer_init(&b->scorer, seq, herr);
+    if (rc) eval_bufs_free(b);
+    return rc;
+}
 
 int tcb_all_finite(const float *x, size_t n)
 {
@@ -209,26 +237,6 @@ static void reconstruction_cd(const tcb_cell_job *job, void *self, int i, int j,
     free(pts);
 }
 
-tcb_pair_record tcb_pair_record_of(int i, int j, const tcb_pair_metrics *m, double cd)
-{
-    return (tcb_pair_record){i, j, m->sl2, m->sl2sq, m->rank, m->auc, cd};
-}
-
-int tcb_cell_score_pair(const tcb_sequence *seq, const tcb_pair_prediction *p, tcb_pair_record *rec,
-                        tcb_summary *sum, tcb_pair_metrics *pm, tcb_error *err)
-{
-    const float *verts_j = tcb_seq_frame(seq, p->j);
-    int nv = seq->n_verts;
-    tcb_pair_metrics m;
-    int rc = p->moved ? tcb_project_to_vertices(verts_j, nv, p->moved, nv, p->pred, err) : TCB_OK;
-    if (!rc) rc = tcb_pair_metrics_compute(verts_j, nv, p->pred, &m, err);
-    if (rc) return rc;
-    *rec = tcb_pair_record_of(p->i, p->j, &m, p->cd);
-    tcb_summary_add_pair(sum, &m, p->cd);
-    if (pm) *pm = m;
-    return TCB_OK;
-}
-
 /* Pair k of the split into rec and the summary; with `cap`, its metrics
  * and reconstructions are kept there too. Failures land in merr (the
  * method's) or herr (the harness's); the caller checks both. */
@@ -268,9 +276,9 @@ static void eval_pair(const tcb_cell_job *job, void *self, int k, eval_bufs *b,
     }
     /* Scored last, on the path scored cells take too; the metrics draw no
      * random numbers, so scoring after the reconstructions changes nothing. */
-    tcb_pair_prediction pred = {i, j, b->moved, b->pred, cd};
+    tcb_pair_prediction pred = {i, j, b->moved, b->pred, cd, b->geo};
     tcb_pair_metrics pm;
-    if (tcb_cell_score_pair(seq, &pred, rec, sum, &pm, herr)) return;
+    if (tcb_cell_score_pair(&b->scorer, &pred, rec, sum, &pm, herr)) return;
     if (cap) cap->i = i, cap->j = j, cap->metrics = pm;
 }
 
@@ -278,11 +286,11 @@ static void evaluate(const tcb_cell_job *job, void *self, tcb_cell_result *c, tc
                      tcb_error *herr)
 {
     const tcb_split *split = job->split;
-    size_t nv = (size_t)job->seq->n_verts;
-    eval_bufs b = {malloc(nv * 3 * sizeof(float)), malloc(nv * sizeof(int32_t))};
+    eval_bufs b;
+    if (eval_bufs_init(job->seq, &b, herr)) return;
     c->pairs = calloc((size_t)split->n_pairs, sizeof *c->pairs);
-    if (!b.moved || !b.pred || !c->pairs) {
-        tcb_fail(herr, TCB_ERR_NOMEM, "out of memory for %zu vertices", nv);
+    if (!c->pairs) {
+        tcb_fail(herr, TCB_ERR_NOMEM, "out of memory for %d pairs", split->n_pairs);
     } else {
         char label[TCB_CELL_LABEL_MAX];
         tcb_cell_label(label, sizeof label, job->dataset->name, job->seq->name,
@@ -300,8 +308,7 @@ static void evaluate(const tcb_cell_job *job, void *self, tcb_cell_result *c, tc
         }
         c->n_pairs = split->n_pairs;
     }
-    free(b.moved);
-    free(b.pred);
+    eval_bufs_free(&b);
 }
 
 /* A failed cell keeps its identity, timings and message, no numbers. */
@@ -365,12 +372,10 @@ static int eval_one_pair(const tcb_cell_job *job, int k, tcb_pair_capture *out, 
         return tcb_fail(err, TCB_ERR_INPUT, "%s: no pair %d (the split has %d: 0 to %d)",
                         job->split_path, k, job->split->n_pairs, job->split->n_pairs - 1);
     tcb_error merr = {0}, herr = {0};
-    size_t nv = (size_t)job->seq->n_verts;
-    eval_bufs b = {malloc(nv * 3 * sizeof(float)), malloc(nv * sizeof(int32_t))};
+    eval_bufs b;
     void *self;
-    if (!b.moved || !b.pred) {
-        tcb_fail(&herr, TCB_ERR_NOMEM, "out of memory for %zu vertices", nv);
-    } else if (prepare_method(job, &self, NULL, &merr) == TCB_OK) {
+    int ready = eval_bufs_init(job->seq, &b, &herr) == TCB_OK;
+    if (ready && prepare_method(job, &self, NULL, &merr) == TCB_OK) {
         tcb_pair_record rec;
         tcb_summary sum;
         tcb_summary_init(&sum);
@@ -380,7 +385,10 @@ static int eval_one_pair(const tcb_cell_job *job, int k, tcb_pair_capture *out, 
         }
         job->ops->destroy(self);
     }
-    out->moved = b.moved, out->pred = b.pred;
+    /* The capture keeps the per-vertex arrays; the graph goes. */
+    out->moved = b.moved, out->pred = b.pred, out->geo = b.geo;
+    b.moved = NULL, b.pred = NULL, b.geo = NULL;
+    eval_bufs_free(&b);
     if (!herr.code && !merr.code) return TCB_OK;
     tcb_pair_capture_free(out);
     if (herr.code) return tcb_fail(err, herr.code, "%s", herr.msg);
@@ -422,6 +430,7 @@ void tcb_pair_capture_free(tcb_pair_capture *c)
 {
     free(c->moved);
     free(c->pred);
+    free(c->geo);
     free(c->recon[0]);
     free(c->recon[1]);
     memset(c, 0, sizeof *c);

@@ -67,14 +67,16 @@ static int worst_pair(const char *run_dir, const target *t, int *k, tcb_error *e
 }
 
 /* Largest relative difference between the recomputed metrics and the
- * file's; frames that differ count as 1. */
+ * file's; frames that differ count as 1. The geodesic ones count when the
+ * file has them (not in a cell written before them). */
 static double row_difference(const tcb_pair_capture *cap, const tcb_pair_record *r)
 {
     if (cap->i != r->i || cap->j != r->j) return 1;
-    const double a[4] = {cap->metrics.sl2.mean, cap->metrics.rank.mean, cap->metrics.auc, cap->cd};
-    const double b[4] = {r->sl2.mean, r->rank.mean, r->auc, r->cd};
+    const tcb_pair_metrics *m = &cap->metrics;
+    const double a[6] = {m->sl2.mean, m->rank.mean, m->auc, cap->cd, m->geo.mean, m->geo_auc};
+    const double b[6] = {r->sl2.mean, r->rank.mean, r->auc, r->cd, r->geo.mean, r->geo_auc};
     double worst = 0;
-    for (int k = 0; k < 4; k++) {
+    for (int k = 0; k < (r->geo.n > 0 ? 6 : 4); k++) {
         if (isnan(a[k]) || isnan(b[k])) {
             if (isnan(a[k]) != isnan(b[k])) return 1;
             continue;
@@ -103,32 +105,52 @@ static int write_recon(const char *dir, const char *name, const tcb_sequence *se
     return rc;
 }
 
-static int write_vertices_csv(const char *dir, const int32_t *pred, const double *verr, int nv,
-                              tcb_error *err)
+static int write_vertices_csv(const char *dir, const tcb_pair_capture *cap, const double *verr,
+                              int nv, tcb_error *err)
 {
     char path[TCB_PATH_MAX];
     tcb_atomic_file af;
     int rc = tcb_path_join(path, sizeof path, err, "%s/vertices.csv", dir);
     if (!rc) rc = tcb_atomic_open(&af, path, err);
     if (rc) return rc;
-    fprintf(af.fp, "vertex,predicted,error\n");
-    for (int k = 0; k < nv; k++) fprintf(af.fp, "%d,%d,%.9g\n", k, pred[k], verr[k]);
+    fprintf(af.fp, "vertex,predicted,error,geodesic\n");
+    for (int k = 0; k < nv; k++)
+        fprintf(af.fp, "%d,%d,%.9g,%.9g\n", k, cap->pred[k], verr[k], cap->geo[k]);
     return tcb_atomic_commit(&af, err);
 }
 
-static cJSON *metrics_json(double sl2, double rank, double auc, double cd)
+/* A number, or null when not finite (no CD) or absent (`has` 0: no
+ * geodesic error in an older cell file). */
+static void add_value(cJSON *o, const char *key, int has, double x)
+{
+    if (!has || isnan(x)) cJSON_AddNullToObject(o, key);
+    else cJSON_AddNumberToObject(o, key, x);
+}
+
+static cJSON *metrics_json(const tcb_pair_metrics *m, double cd)
 {
     cJSON *o = cJSON_CreateObject();
-    cJSON_AddNumberToObject(o, "sl2", sl2);
-    cJSON_AddNumberToObject(o, "rank", rank);
-    cJSON_AddNumberToObject(o, "auc", auc);
-    if (isnan(cd)) cJSON_AddNullToObject(o, "cd");
-    else cJSON_AddNumberToObject(o, "cd", cd);
+    cJSON_AddNumberToObject(o, "sl2", m->sl2.mean);
+    cJSON_AddNumberToObject(o, "rank", m->rank.mean);
+    cJSON_AddNumberToObject(o, "auc", m->auc);
+    add_value(o, "cd", 1, cd);
+    add_value(o, "geo", m->geo.n > 0, m->geo.mean);
+    add_value(o, "geo_auc", m->geo.n > 0, m->geo_auc);
+    add_value(o, "geo_unreachable", m->geo.n > 0, m->geo_unreachable);
     return o;
 }
 
+/* The cell file's row in the shape of the recomputed metrics. */
+static tcb_pair_metrics record_metrics(const tcb_pair_record *r)
+{
+    tcb_pair_metrics m = {.sl2 = r->sl2, .sl2sq = r->sl2sq, .rank = r->rank, .auc = r->auc,
+                          .geo = r->geo, .geo_auc = r->geo_auc,
+                          .geo_unreachable = r->geo_unreachable};
+    return m;
+}
+
 static int write_pair_json(const char *dir, const target *t, int k, const tcb_pair_capture *cap,
-                           const cell_row *row, double diff, tcb_error *err)
+                           const cell_row *row, double diff, double area, tcb_error *err)
 {
     cJSON *j = cJSON_CreateObject();
     cJSON_AddStringToObject(j, "format", "tcbench-inspect/1");
@@ -139,17 +161,19 @@ static int write_pair_json(const char *dir, const target *t, int k, const tcb_pa
     cJSON_AddNumberToObject(j, "pair", k);
     cJSON_AddNumberToObject(j, "i", cap->i);
     cJSON_AddNumberToObject(j, "j", cap->j);
-    cJSON_AddItemToObject(j, "recomputed", metrics_json(cap->metrics.sl2.mean, cap->metrics.rank.mean,
-                                                        cap->metrics.auc, cap->cd));
+    cJSON_AddNumberToObject(j, "target_area", area);
+    cJSON_AddItemToObject(j, "recomputed", metrics_json(&cap->metrics, cap->cd));
     if (row->found) {
-        cJSON_AddItemToObject(j, "cell", metrics_json(row->rec.sl2.mean, row->rec.rank.mean,
-                                                      row->rec.auc, row->rec.cd));
+        tcb_pair_metrics m = record_metrics(&row->rec);
+        cJSON_AddItemToObject(j, "cell", metrics_json(&m, row->rec.cd));
         cJSON_AddNumberToObject(j, "max_relative_difference", diff);
     } else {
         cJSON_AddNullToObject(j, "cell");
         cJSON_AddStringToObject(j, "cell_note", row->note);
     }
-    cJSON_AddStringToObject(j, "units", "normalized coordinates; sl2 Euclidean, rank and auc fractions, cd squared");
+    cJSON_AddStringToObject(j, "units", "normalized coordinates; sl2 Euclidean, rank and auc fractions, cd "
+                                        "squared; geo the geodesic error over sqrt(target_area), geo_auc "
+                                        "a fraction, geo_unreachable a vertex count");
     cJSON_AddStringToObject(j, "colours",
                             "source/target/transfer: xyz of the first frame -> rgb; error: viridis "
                             "from 0 to sqrt(0.02); recon: colour of the nearest GT vertex");
@@ -213,22 +237,26 @@ static int write_files(const char *dir, const tcb_sequence *seq, const target *t
     if (!rc && cap->recon[1])
         rc = write_recon(dir, "recon_j.ply", seq, cap->j, cap->recon[1], cap->n_recon[1], pos, err);
     if (!rc) rc = write_picture(dir, seq, cap, pos, moved, errc, err);
-    if (!rc) rc = write_vertices_csv(dir, cap->pred, verr, seq->n_verts, err);
-    if (!rc) rc = write_pair_json(dir, t, k, cap, row, diff, err);
+    if (!rc) rc = write_vertices_csv(dir, cap, verr, seq->n_verts, err);
+    if (!rc) rc = write_pair_json(dir, t, k, cap, row, diff, seq->areas[cap->j], err);
     free(pos);
     free(moved);
     free(errc);
     return rc;
 }
 
-/* "  m_sL2 …  CD …" in table units; "-" for a missing CD. */
-static void print_metrics(FILE *out, const char *what, double sl2, double rank, double auc,
-                          double cd)
+/* "  m_sL2 …  CD …  m_geo …  AUC_geo …" in table units; "-" for a missing
+ * CD or geodesic error. */
+static void print_metrics(FILE *out, const char *what, const tcb_pair_metrics *m, double cd)
 {
-    fprintf(out, "  %-10s  m_sL2 %8.2f  rank %6.2f  AUC %6.2f  CD ", what, 1e3 * sl2, 1e2 * rank,
-            1e2 * auc);
+    fprintf(out, "  %-10s  m_sL2 %8.2f  rank %6.2f  AUC %6.2f  CD ", what, 1e3 * m->sl2.mean,
+            1e2 * m->rank.mean, 1e2 * m->auc);
     if (isnan(cd)) fprintf(out, "%7s", "-");
     else fprintf(out, "%7.3f", 1e3 * cd);
+    if (m->geo.n > 0)
+        fprintf(out, "  m_geo %8.2f  AUC_geo %6.2f", 1e3 * m->geo.mean, 1e2 * m->geo_auc);
+    else
+        fprintf(out, "  m_geo %8s  AUC_geo %6s", "-", "-");
 }
 
 static void print_account(FILE *out, const target *t, int k, const tcb_pair_capture *cap,
@@ -237,12 +265,11 @@ static void print_account(FILE *out, const target *t, int k, const tcb_pair_capt
     if (!out) return;
     fprintf(out, "%s/%s %s seed %d, pair %d: frame %d -> frame %d\n", t->d->name, t->s->name,
             t->m->label, t->seed, k, cap->i, cap->j);
-    print_metrics(out, "recomputed", cap->metrics.sl2.mean, cap->metrics.rank.mean,
-                  cap->metrics.auc, cap->cd);
+    print_metrics(out, "recomputed", &cap->metrics, cap->cd);
     fputc('\n', out);
     if (row->found) {
-        print_metrics(out, "cell file", row->rec.sl2.mean, row->rec.rank.mean, row->rec.auc,
-                      row->rec.cd);
+        tcb_pair_metrics m = record_metrics(&row->rec);
+        print_metrics(out, "cell file", &m, row->rec.cd);
         fprintf(out, "  (%s: largest relative difference %.1e)\n", diff <= 1e-6 ? "agree" : "DIFFER",
                 diff);
     } else {
@@ -257,6 +284,10 @@ static void print_account(FILE *out, const target *t, int k, const tcb_pair_capt
     fprintf(out, "  vertices beyond the PCK range (error > %.4f): %d of %d (%.1f %%); worst: "
                  "vertex %d -> %d, error %.4f\n",
             cut, beyond, nv, 100.0 * beyond / nv, worst, cap->pred[worst], verr[worst]);
+    if (cap->metrics.geo_unreachable > 0)
+        fprintf(out, "  geodesic: %d vertices predicted on another piece of the mesh, scored by "
+                     "the straight line\n",
+                cap->metrics.geo_unreachable);
 }
 
 /* Evaluates pair *k (resolved from "worst" when < 0) of the opened cell

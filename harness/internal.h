@@ -11,6 +11,7 @@
 #include <stdatomic.h>
 
 #include "tcb/config.h"
+#include "tcb/geodesic.h"
 #include "tcb/method.h"
 #include "tcb/metrics.h"
 #include "tcb/results.h"
@@ -235,18 +236,32 @@ typedef struct tcb_pair_prediction {
     int32_t *pred;            /* [n_verts] the predicted vertex of frame j per vertex; the
                                * projection of moved is written here */
     double cd;                /* the pair's Chamfer distance; NaN without reconstructions */
+    double *geo;              /* [n_verts] out: each vertex's normalised geodesic error; NULL
+                               * when not wanted */
 } tcb_pair_prediction;
 
-/* The cell file's record of pair (i, j): its metrics and Chamfer distance
- * (NaN: none). (harness/cell.c) */
+/* What scoring a sequence's pairs needs beside the predictions: the
+ * sequence, and the edge graph of its faces for the geodesic error
+ * (tcb/geodesic.h), made once for all pairs since every frame shares the
+ * faces. (harness/pair_score.c) */
+typedef struct tcb_pair_scorer {
+    const tcb_sequence *seq;
+    tcb_edge_graph graph;
+} tcb_pair_scorer;
+int tcb_pair_scorer_init(tcb_pair_scorer *s, const tcb_sequence *seq, tcb_error *err);
+void tcb_pair_scorer_free(tcb_pair_scorer *s);
+
+/* The cell file's record of pair (i, j): its metrics (the geodesic ones
+ * when m has them) and Chamfer distance (NaN: none). (harness/pair_score.c) */
 tcb_pair_record tcb_pair_record_of(int i, int j, const tcb_pair_metrics *m, double cd);
 
 /* Scores one pair: moved (when given) projected onto frame j's nearest GT
- * vertices, the metrics (into *pm; may be NULL), the cell file's record
- * into *rec, and the pair added to *sum. The one path from a prediction to
- * a cell's numbers, for methods' cells and scored cells alike, so a metric
- * added here reaches both. (harness/cell.c) */
-int tcb_cell_score_pair(const tcb_sequence *seq, const tcb_pair_prediction *p, tcb_pair_record *rec,
+ * vertices, the metrics, the geodesic error among them (into *pm; may be
+ * NULL), the cell file's record into *rec, and the pair added to *sum. The
+ * one path from a prediction to a cell's numbers, for methods' cells and
+ * scored cells alike, so a metric added here reaches both.
+ * (harness/pair_score.c) */
+int tcb_cell_score_pair(const tcb_pair_scorer *s, const tcb_pair_prediction *p, tcb_pair_record *rec,
                         tcb_summary *sum, tcb_pair_metrics *pm, tcb_error *err);
 
 /* One evaluation pair of a cell exactly as tcb_cell_run computes it (same
@@ -255,6 +270,7 @@ typedef struct tcb_pair_capture {
     int i, j;                 /* frames: source, target */
     float *moved;             /* [n_verts][3] the method's transfer of frame i's vertices */
     int32_t *pred;            /* [n_verts] predicted vertex ids of frame j */
+    double *geo;              /* [n_verts] each vertex's normalised geodesic error */
     tcb_pair_metrics metrics;
     double cd;                /* NaN without reconstruct */
     float *recon[2];          /* [n_recon[f]][3] surface samples of frames i, j, or NULL */

@@ -13,9 +13,9 @@
 
 const char *const tcb_cell_status_names[] = {"ok", "failed", "diverged", NULL};
 const char *const tcb_cell_role_names[] = {"train", "validation", "test", NULL};
-const char *const tcb_cell_pair_columns[] = {"i",       "j",     "n",        "sl2",
-                                             "sl2_m2",  "sl2sq", "sl2sq_m2", "rank",
-                                             "rank_m2", "auc",   "cd",       NULL};
+const char *const tcb_cell_pair_columns[] = {
+    "i",   "j",   "n",   "sl2",    "sl2_m2",  "sl2sq",   "sl2sq_m2",        "rank",
+    "rank_m2", "auc", "cd", "geo", "geo_m2", "geo_auc", "geo_unreachable", NULL};
 
 const char *tcb_cell_status_name(tcb_cell_status s)
 {
@@ -120,14 +120,27 @@ static void add_summary(builder *b, cJSON *root, const tcb_summary *s)
         add(b, o, "cd", cJSON_CreateNull());
     cJSON *pck = add(b, o, "pck", cJSON_CreateArray());
     for (int k = 0; pck && k < TCB_PCK_STEPS; k++) append(b, pck, num_or_null(s->pck[k]));
+    add_stat(b, o, "geo", &s->geo);
+    add_stat(b, o, "geo_auc", &s->geo_auc);
+    cJSON *geo_pck = add(b, o, "geo_pck", cJSON_CreateArray());
+    for (int k = 0; geo_pck && k < TCB_GEO_PCK_STEPS; k++)
+        append(b, geo_pck, num_or_null(s->geo_pck[k]));
+    add_num(b, o, "geo_unreachable", s->geo_unreachable);
 }
 
 void tcb_pair_record_row(const tcb_pair_record *r, double *v)
 {
+    /* A pair without geodesic values (a cell loaded from an older file)
+     * writes them as null. */
+    int geo = r->geo.n > 0;
     const double row[TCB_N_PAIR_COLUMNS] = {r->i,         r->j,          r->sl2.n,
                                             r->sl2.mean,  r->sl2.m2,     r->sl2sq.mean,
                                             r->sl2sq.m2,  r->rank.mean,  r->rank.m2,
-                                            r->auc,       r->cd};
+                                            r->auc,       r->cd,
+                                            geo ? r->geo.mean : NAN,
+                                            geo ? r->geo.m2 : NAN,
+                                            geo ? r->geo_auc : NAN,
+                                            geo ? r->geo_unreachable : NAN};
     memcpy(v, row, sizeof row);
 }
 
@@ -161,10 +174,11 @@ static int check_for_save(const char *path, const tcb_cell_result *c, tcb_error 
         role_known |= !strcmp(c->role, tcb_cell_role_names[k]);
     if (!role_known)
         return tcb_fail(err, TCB_ERR_INTERNAL, "%s: invalid role \"%s\"", path, c->role);
-    /* One "n" column serves the three per-vertex statistics of a pair. */
+    /* One "n" column serves the per-vertex statistics of a pair (the
+     * geodesic one has it too, or none). */
     for (int p = 0; p < c->n_pairs; p++) {
         const tcb_pair_record *r = &c->pairs[p];
-        if (r->sl2sq.n != r->sl2.n || r->rank.n != r->sl2.n)
+        if (r->sl2sq.n != r->sl2.n || r->rank.n != r->sl2.n || (r->geo.n && r->geo.n != r->sl2.n))
             return tcb_fail(err, TCB_ERR_INTERNAL, "%s: pair %d: statistics disagree on n",
                             path, p);
     }

@@ -15,7 +15,11 @@
 /* Largest integer a JSON number (a double) holds exactly. */
 #define TCB_JSON_INT_MAX 9007199254740992.0
 
-#define TCB_N_PAIR_COLUMNS 11
+/* The pair columns: the paper's metrics, then the geodesic error's. Cells
+ * written before the geodesic error have only the first
+ * TCB_N_PAIR_COLUMNS_EUCLIDEAN, and load with no geodesic values. */
+#define TCB_N_PAIR_COLUMNS 15
+#define TCB_N_PAIR_COLUMNS_EUCLIDEAN 11
 
 extern const char *const tcb_cell_status_names[]; /* indexed by tcb_cell_status; NULL-terminated */
 extern const char *const tcb_cell_role_names[];   /* "train", "validation", "test", NULL */

@@ -19,8 +19,12 @@ static const char *const TOP_KEYS[] = {
     "summary",      "pair_columns",    "pairs",    NULL};
 static const char *const TIMING_KEYS[] = {"load_s", "fit_s", "eval_s", NULL};
 static const char *const SPLIT_KEYS[] = {"path", "seed", "n_pairs", NULL};
-static const char *const SUMMARY_KEYS[] = {"n_pairs", "sl2", "sl2sq", "rank",
-                                           "auc",     "cd",  "pck",   NULL};
+static const char *const SUMMARY_KEYS[] = {"n_pairs", "sl2",     "sl2sq",   "rank",
+                                           "auc",     "cd",      "pck",     "geo",
+                                           "geo_auc", "geo_pck", "geo_unreachable", NULL};
+/* The summary's geodesic keys: all or none (none in a cell written before
+ * the geodesic error). */
+static const char *const GEO_KEYS[] = {"geo", "geo_auc", "geo_pck", "geo_unreachable", NULL};
 static const char *const STAT_KEYS[] = {"n", "mean", "m2", NULL};
 
 /* Key paths for messages ("file: summary.sl2.mean"); a path too long for
@@ -94,6 +98,43 @@ static int load_stat(const cJSON *obj, const char *key, const char *where, tcb_s
     return num_or_null_key(o, "m2", sub, &s->m2, err);
 }
 
+/* A PCK curve: an array of `steps` numbers (null for non-finite). */
+static int load_curve(const cJSON *o, const char *key, const char *where, int steps, double *out,
+                      tcb_error *err)
+{
+    const cJSON *curve = cJSON_GetObjectItemCaseSensitive(o, key);
+    if (!cJSON_IsArray(curve) || cJSON_GetArraySize(curve) != steps)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: expected an array of %d numbers", where, key,
+                        steps);
+    int k = 0;
+    for (const cJSON *v = curve->child; v; v = v->next, k++) {
+        char at[TCB_ERRMSG_MAX];
+        key_path(at, sizeof at, "%s.%s[%d]", where, key, k);
+        int rc = value_or_null(v, at, &out[k], err);
+        if (rc) return rc;
+    }
+    return TCB_OK;
+}
+
+/* The geodesic keys when the cell has them; without, the summary keeps
+ * geo.n = geo_auc.n = 0 (no geodesic values). */
+static int load_summary_geodesic(const cJSON *o, const char *sub, tcb_summary *s, tcb_error *err)
+{
+    int present = 0, rc;
+    for (int k = 0; GEO_KEYS[k]; k++) present += cJSON_HasObjectItem(o, GEO_KEYS[k]);
+    if (!present) return TCB_OK;
+    for (int k = 0; GEO_KEYS[k]; k++)
+        if (!cJSON_HasObjectItem(o, GEO_KEYS[k]))
+            return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: missing key (the geodesic keys go together)",
+                            sub, GEO_KEYS[k]);
+    if ((rc = load_stat(o, "geo", sub, &s->geo, err)) ||
+        (rc = load_stat(o, "geo_auc", sub, &s->geo_auc, err)) ||
+        (rc = load_curve(o, "geo_pck", sub, TCB_GEO_PCK_STEPS, s->geo_pck, err)))
+        return rc;
+    return tcb_json_num(o, "geo_unreachable", sub, 1, 0, 0, TCB_JSON_INT_MAX, &s->geo_unreachable,
+                        err);
+}
+
 static int load_summary(const cJSON *root, const char *where, tcb_summary *s, tcb_error *err)
 {
     char sub[TCB_ERRMSG_MAX];
@@ -112,31 +153,26 @@ static int load_summary(const cJSON *root, const char *where, tcb_summary *s, tc
         s->cd = (tcb_stat){0, 0, 0};
     else if ((rc = load_stat(o, "cd", sub, &s->cd, err)))
         return rc;
-    const cJSON *pck = cJSON_GetObjectItemCaseSensitive(o, "pck");
-    if (!cJSON_IsArray(pck) || cJSON_GetArraySize(pck) != TCB_PCK_STEPS)
-        return tcb_fail(err, TCB_ERR_INPUT, "%s.pck: expected an array of %d numbers", sub,
-                        TCB_PCK_STEPS);
-    int k = 0;
-    for (const cJSON *v = pck->child; v; v = v->next, k++) {
-        char at[TCB_ERRMSG_MAX];
-        key_path(at, sizeof at, "%s.pck[%d]", sub, k);
-        if ((rc = value_or_null(v, at, &s->pck[k], err))) return rc;
-    }
-    return TCB_OK;
+    if ((rc = load_curve(o, "pck", sub, TCB_PCK_STEPS, s->pck, err))) return rc;
+    return load_summary_geodesic(o, sub, s, err);
 }
 
-static int load_pair_columns(const cJSON *root, const char *where, tcb_error *err)
+/* The columns, all of them or the Euclidean ones of an older cell; their
+ * count goes to *n. */
+static int load_pair_columns(const cJSON *root, const char *where, int *n, tcb_error *err)
 {
     const cJSON *cols = cJSON_GetObjectItemCaseSensitive(root, "pair_columns");
-    int ok = cJSON_IsArray(cols) && cJSON_GetArraySize(cols) == TCB_N_PAIR_COLUMNS;
+    *n = cJSON_IsArray(cols) ? cJSON_GetArraySize(cols) : -1;
+    int ok = *n == TCB_N_PAIR_COLUMNS || *n == TCB_N_PAIR_COLUMNS_EUCLIDEAN;
     int k = 0;
     for (const cJSON *c = ok ? cols->child : NULL; c; c = c->next, k++)
         ok = ok && cJSON_IsString(c) && !strcmp(c->valuestring, tcb_cell_pair_columns[k]);
     if (!ok)
         return tcb_fail(err, TCB_ERR_INPUT,
-                        "%s.pair_columns: expected [\"i\", \"j\", \"n\", \"sl2\", …, \"cd\"] "
-                        "(%d columns of format %s)",
-                        where, TCB_N_PAIR_COLUMNS, TCB_CELL_FORMAT);
+                        "%s.pair_columns: expected [\"i\", \"j\", \"n\", \"sl2\", …, \"cd\", "
+                        "\"geo\", …, \"geo_unreachable\"] (%d columns of format %s, or the first "
+                        "%d of a cell without geodesic error)",
+                        where, TCB_N_PAIR_COLUMNS, TCB_CELL_FORMAT, TCB_N_PAIR_COLUMNS_EUCLIDEAN);
     return TCB_OK;
 }
 
@@ -149,16 +185,38 @@ static int pair_index(const cJSON *v, const char *at, int *out, tcb_error *err)
     return TCB_OK;
 }
 
-static int load_pair(const cJSON *row, const char *at, tcb_pair_record *r, tcb_error *err)
+/* The geodesic columns x[9 ..] (geo, geo_m2, geo_auc, geo_unreachable)
+ * of a pair with n vertices: all null (none), or all numbers. */
+static int pair_geodesic(const double *x, double n, const char *at, tcb_pair_record *r,
+                         tcb_error *err)
 {
-    if (!cJSON_IsArray(row) || cJSON_GetArraySize(row) != TCB_N_PAIR_COLUMNS)
-        return tcb_fail(err, TCB_ERR_INPUT, "%s: expected an array of %d values", at,
-                        TCB_N_PAIR_COLUMNS);
+    int nulls = isnan(x[9]) + isnan(x[10]) + isnan(x[11]) + isnan(x[12]);
+    if (nulls == 4) return TCB_OK;
+    if (nulls || !(x[12] >= 0) || x[12] > n || x[12] != floor(x[12]))
+        return tcb_fail(err, TCB_ERR_INPUT,
+                        "%s: the geodesic columns must be numbers (geo_unreachable a count of "
+                        "at most n) or all null",
+                        at);
+    r->geo = (tcb_stat){n, x[9], x[10]};
+    r->geo_auc = x[11];
+    r->geo_unreachable = (int)x[12];
+    return TCB_OK;
+}
+
+/* A row of n_cols values (TCB_N_PAIR_COLUMNS, or the Euclidean ones). */
+static int load_pair(const cJSON *row, int n_cols, const char *at, tcb_pair_record *r,
+                     tcb_error *err)
+{
+    if (!cJSON_IsArray(row) || cJSON_GetArraySize(row) != n_cols)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: expected an array of %d values", at, n_cols);
     const cJSON *v = row->child;
     int rc;
     if ((rc = pair_index(v, at, &r->i, err))) return rc;
     if ((rc = pair_index(v->next, at, &r->j, err))) return rc;
-    double x[TCB_N_PAIR_COLUMNS - 2]; /* n, sl2, sl2_m2, sl2sq, sl2sq_m2, rank, rank_m2, auc, cd */
+    /* n, sl2, sl2_m2, sl2sq, sl2sq_m2, rank, rank_m2, auc, cd, then the
+     * geodesic ones (null when the cell has none) */
+    double x[TCB_N_PAIR_COLUMNS - 2];
+    for (int k = 0; k < TCB_N_PAIR_COLUMNS - 2; k++) x[k] = NAN;
     int k = 0;
     for (v = v->next->next; v; v = v->next, k++)
         if ((rc = value_or_null(v, at, &x[k], err))) return rc;
@@ -168,10 +226,11 @@ static int load_pair(const cJSON *row, const char *at, tcb_pair_record *r, tcb_e
     r->rank = (tcb_stat){x[0], x[5], x[6]};
     r->auc = x[7];
     r->cd = x[8];
-    return TCB_OK;
+    return pair_geodesic(x, x[0], at, r, err);
 }
 
-static int load_pairs(const cJSON *root, const char *where, tcb_cell_result *c, tcb_error *err)
+static int load_pairs(const cJSON *root, int n_cols, const char *where, tcb_cell_result *c,
+                      tcb_error *err)
 {
     const cJSON *rows = cJSON_GetObjectItemCaseSensitive(root, "pairs");
     if (!cJSON_IsArray(rows))
@@ -186,7 +245,7 @@ static int load_pairs(const cJSON *root, const char *where, tcb_cell_result *c, 
     for (const cJSON *row = rows->child; row; row = row->next, p++) {
         char at[TCB_ERRMSG_MAX];
         key_path(at, sizeof at, "%s.pairs[%d]", where, p);
-        int rc = load_pair(row, at, &c->pairs[p], err);
+        int rc = load_pair(row, n_cols, at, &c->pairs[p], err);
         if (rc) return rc;
     }
     return TCB_OK;
@@ -266,11 +325,13 @@ static int load_timings_split(const cJSON *root, const char *where, tcb_cell_res
 static int cell_from_json(const cJSON *root, const char *path, tcb_cell_result *c,
                           tcb_error *err)
 {
+    int n_cols;
     int rc = tcb_json_expect_object(root, path, err);
     if (rc || (rc = load_header(root, path, c, err)) || (rc = load_params(root, path, c, err)) ||
         (rc = load_timings_split(root, path, c, err)) ||
         (rc = load_summary(root, path, &c->summary, err)) ||
-        (rc = load_pair_columns(root, path, err)) || (rc = load_pairs(root, path, c, err)))
+        (rc = load_pair_columns(root, path, &n_cols, err)) ||
+        (rc = load_pairs(root, n_cols, path, c, err)))
         return rc;
     /* A finished ok cell scored every pair of its split. */
     if (c->status == TCB_CELL_OK && c->summary.n_pairs != c->n_pairs)

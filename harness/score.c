@@ -72,17 +72,21 @@ static int score_pairs(const char *dir, const tcb_sequence *seq, const tcb_split
     float *moved = malloc(nv * 3 * sizeof *moved);
     c->pairs = calloc((size_t)split->n_pairs + 1, sizeof *c->pairs);
     c->n_pairs = split->n_pairs;
+    tcb_pair_scorer scorer = {0};
     int rc = !pred || !moved || !c->pairs ? tcb_fail(err, TCB_ERR_NOMEM, "out of memory for %zu vertices", nv) : TCB_OK;
+    if (!rc) rc = tcb_pair_scorer_init(&scorer, seq, err);
     for (int k = 0; !rc && k < split->n_pairs; k++) {
         char path[TCB_PATH_MAX];
         int is_points = 0;
         rc = tcb_path_join(path, sizeof path, err, "%s/%d.npy", dir, k);
         if (!rc) rc = tcb_score_read_prediction(path, seq->n_verts, pred, moved, &is_points, err);
         if (rc) break;
-        tcb_pair_prediction p = {split->pairs[2 * k], split->pairs[2 * k + 1], is_points ? moved : NULL, pred, NAN};
-        rc = tcb_cell_score_pair(seq, &p, &c->pairs[k], &c->summary, NULL, err);
+        tcb_pair_prediction p = {split->pairs[2 * k], split->pairs[2 * k + 1], is_points ? moved : NULL, pred, NAN,
+                                 NULL};
+        rc = tcb_cell_score_pair(&scorer, &p, &c->pairs[k], &c->summary, NULL, err);
         if (rc) tcb_error_prefix(err, "%s: ", path);
     }
+    tcb_pair_scorer_free(&scorer);
     free(pred);
     free(moved);
     return rc;

@@ -15,12 +15,16 @@
 /* Below this many vertices the rank loop stays single-threaded. */
 #define PAR_MIN_VERTS 256
 
-double tcb_pck_threshold(int s)
+/* numpy.linspace(0, max, steps)[s]: s·step, the last value max exactly. */
+static double linspace(double max, int steps, int s)
 {
-    /* numpy.linspace(0, max, steps): s·step, the last value set to max exactly. */
-    if (s >= TCB_PCK_STEPS - 1) return TCB_PCK_MAX;
-    return (double)s * (TCB_PCK_MAX / (TCB_PCK_STEPS - 1));
+    if (s >= steps - 1) return max;
+    return (double)s * (max / (steps - 1));
 }
+
+double tcb_pck_threshold(int s) { return linspace(TCB_PCK_MAX, TCB_PCK_STEPS, s); }
+
+double tcb_geo_pck_threshold(int s) { return linspace(TCB_GEO_PCK_MAX, TCB_GEO_PCK_STEPS, s); }
 
 int tcb_project_to_vertices(const float *verts_j, int nv, const float *pts, int n,
                             int32_t *idx, tcb_error *err)
@@ -101,18 +105,19 @@ static int ranks(const double *x, const double *y, const double *z, int nv, cons
     return 0;
 }
 
-static void pck_curve(const double *d, int nv, tcb_pair_metrics *out)
+void tcb_pck_curve(const double *d, int n, double (*threshold)(int), int steps, double *pck,
+                   double *auc)
 {
     double sum = 0.0;
-    for (int s = 0; s < TCB_PCK_STEPS; s++) {
-        double t = tcb_pck_threshold(s);
+    for (int s = 0; s < steps; s++) {
+        double t = threshold(s);
         long long c = 0;
 #pragma omp simd reduction(+ : c)
-        for (int k = 0; k < nv; k++) c += d[k] <= t;
-        out->pck[s] = (double)c / nv;
-        sum += out->pck[s];
+        for (int k = 0; k < n; k++) c += d[k] <= t;
+        pck[s] = (double)c / n;
+        sum += pck[s];
     }
-    out->auc = sum / TCB_PCK_STEPS;
+    *auc = sum / steps;
 }
 
 static int check_pred(int nv, const int32_t *pred, tcb_error *err)
@@ -154,7 +159,7 @@ void tcb_pair_metrics_summarize(const double *sq, const double *rank, int nv, tc
         tcb_stat_push(&out->sl2sq, sq[k]);
         tcb_stat_push(&out->rank, rank[k]);
     }
-    pck_curve(sq, nv, out);
+    tcb_pck_curve(sq, nv, tcb_pck_threshold, TCB_PCK_STEPS, out->pck, &out->auc);
 }
 
 int tcb_pair_metrics_compute(const float *verts_j, int nv, const int32_t *pred,

@@ -3,8 +3,11 @@
  *
  * One block per (dataset, sequence), one row per method, seeds pooled with
  * tcb_summary_merge. Values are in table units (m_sL2 ×1e3, rank %, AUC %,
- * CD ×1e3). A row shows numbers only when every pooled cell is "ok";
- * otherwise it carries the status, so a failure never hides behind a number. */
+ * CD ×1e3, m_geo ×1e3, AUC_geo %). A row shows numbers only when every
+ * pooled cell is "ok"; otherwise it carries the status, so a failure never
+ * hides behind a number. The geodesic columns (tcb/geodesic.h, not the
+ * paper's) show "-" unless every pooled pair has them: a cell written
+ * before the geodesic error existed has none. */
 #ifndef TCB_REPORTS_AGGREGATE_H
 #define TCB_REPORTS_AGGREGATE_H
 
@@ -19,6 +22,8 @@ typedef enum tcb_rpt_metric {
     TCB_M_RANK,
     TCB_M_AUC,
     TCB_M_CD,
+    TCB_M_GEO,      /* the geodesic error and its AUC: tcbench's addition */
+    TCB_M_GEO_AUC,
     TCB_N_METRICS
 } tcb_rpt_metric;
 
@@ -29,6 +34,8 @@ typedef struct tcb_rpt_metric_def {
     double scale;          /* raw value × scale = table units */
     int decimals;          /* printf precision in table units */
     int lower_is_better;
+    int paper;             /* one of the paper's metrics; 0: an addition, which baselines
+                            * and references written before it may lack */
 } tcb_rpt_metric_def;
 
 extern const tcb_rpt_metric_def tcb_rpt_metrics[TCB_N_METRICS];
@@ -64,6 +71,9 @@ typedef struct tcb_rpt_row {
     double std[TCB_N_METRICS];        /* table units */
     double sl2sq_mean, sl2sq_std;     /* ×1e3; valid when has[TCB_M_SL2] */
     double pck[TCB_PCK_STEPS];        /* percent; valid when status is "ok" */
+    double geo_pck[TCB_GEO_PCK_STEPS]; /* percent; valid when has[TCB_M_GEO] */
+    double geo_vertices;              /* vertices the geodesic error pooled */
+    double geo_unreachable;           /* of them scored by the Euclidean fallback */
     int n_gaps;                       /* largest |i − j| + 1; 0 unless ok, and in MEAN rows */
     tcb_rpt_gap *by_gap;              /* malloc'ed [n_gaps], indexed by |i − j| */
     int n_by_seed;                    /* = n_seeds; 0 in MEAN rows */

@@ -17,8 +17,9 @@
 static const char *const STATUS_NAMES[] = {"ok", "failed", "diverged", NULL};
 static const char *const TOP_KEYS[] = {"format", "tolerances", "rows", NULL};
 static const char *const TOL_KEYS[] = {"abs", "rel", NULL};
-static const char *const ROW_KEYS[] = {"dataset", "sequence", "method", "sl2",        "rank",
-                                       "auc",     "cd",       "status", "tolerances", NULL};
+static const char *const ROW_KEYS[] = {"dataset", "sequence", "method", "sl2",
+                                       "rank",    "auc",      "cd",     "geo",
+                                       "geo_auc", "status",   "tolerances", NULL};
 
 /* ----------------------------------------------------------------- write */
 
@@ -80,8 +81,9 @@ int tcb_baseline_write(const char *run_dir, const char *baseline_path, tcb_error
 /* ------------------------------------------------------------------ load */
 
 /* The tolerances object t ({metric: {"abs", "rel"}}) into abs_tol, rel_tol;
- * with `every`, each metric must be there (the top level), else a metric
- * left out keeps its value (a row's own tolerances). */
+ * with `every`, each of the paper's metrics must be there (the top level),
+ * else a metric left out keeps its value (a row's own tolerances, or the
+ * default of a metric added since the baseline was written). */
 static int parse_tolerances(const cJSON *t, const char *where, int every, double *abs_tol, double *rel_tol,
                             tcb_error *err)
 {
@@ -92,7 +94,7 @@ static int parse_tolerances(const cJSON *t, const char *where, int every, double
         char sub[TCB_ERRMSG_MAX];
         snprintf(sub, sizeof sub, "%s.%s", where, keys[m]);
         const cJSON *o = cJSON_GetObjectItemCaseSensitive(t, keys[m]);
-        if (!o && !every) continue;
+        if (!o && (!every || !tcb_rpt_metrics[m].paper)) continue;
         if (!o) return tcb_fail(err, TCB_ERR_INPUT, "%s: required key is missing", sub);
         if ((rc = tcb_json_expect_keys(o, sub, TOL_KEYS, err)) ||
             (rc = tcb_json_num(o, "abs", sub, 1, 0, 0, INFINITY, &abs_tol[m], err)))
@@ -104,6 +106,7 @@ static int parse_tolerances(const cJSON *t, const char *where, int every, double
 
 static int load_tolerances(const cJSON *root, const char *path, tcb_baseline *b, tcb_error *err)
 {
+    for (int m = 0; m < TCB_N_METRICS; m++) b->abs_tol[m] = DEFAULT_ABS_TOL, b->rel_tol[m] = DEFAULT_REL_TOL;
     char where[TCB_ERRMSG_MAX - 16]; /* room for ".<metric>" in sub */
     snprintf(where, sizeof where, "%s: tolerances", path);
     const cJSON *t = cJSON_GetObjectItemCaseSensitive(root, "tolerances");
@@ -140,7 +143,9 @@ static int load_row(const cJSON *o, const char *where, const tcb_baseline *b, tc
     for (int m = 0; m < TCB_N_METRICS; m++) {
         const char *key = tcb_rpt_metrics[m].key;
         const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+        if (!v && !tcb_rpt_metrics[m].paper) continue; /* not checked */
         if (!v) return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: required key is missing", where, key);
+        r->checked[m] = 1;
         if (!cJSON_IsNull(v) && !(cJSON_IsNumber(v) && isfinite(v->valuedouble)))
             return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: expected a number or null", where, key);
         r->has[m] = cJSON_IsNumber(v);

@@ -163,8 +163,11 @@ void tcb_chart_legend(tcb_chart *c, const tcb_rpt_block *b, const char *heading,
             cairo_move_to(cr, LEGEND_X, y);
             cairo_line_to(cr, LEGEND_X + 28, y);
             cairo_stroke(cr);
-            snprintf(label, sizeof label, "%s (%.*f)", r->method,
-                     tcb_rpt_metrics[metric].decimals, r->mean[metric]);
+            if (r->has[metric])
+                snprintf(label, sizeof label, "%s (%.*f)", r->method,
+                         tcb_rpt_metrics[metric].decimals, r->mean[metric]);
+            else /* e.g. no geodesic error in an older cell */
+                snprintf(label, sizeof label, "%s (-)", r->method);
             cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
         } else {
             snprintf(label, sizeof label, "%s: %s", r->method, r->status_text);

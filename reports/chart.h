@@ -41,7 +41,8 @@ void tcb_chart_series_begin(tcb_chart *c, int k);
 void tcb_chart_series_end(tcb_chart *c);
 
 /* One legend entry per row: "method (value)" with row r's mean of `metric`
- * for ok rows, "method: status" in grey otherwise. */
+ * for ok rows ("method (-)" when it has none), "method: status" in grey
+ * otherwise. */
 void tcb_chart_legend(tcb_chart *c, const tcb_rpt_block *b, const char *heading, int metric);
 
 /* A title line and a grey subtitle line above the axes. */

@@ -1,6 +1,8 @@
 /* `tcbench check`: a run's table rows against a baseline, as a fixed-width
  * diff table. A row drifts when any of its values leaves its tolerance, its
- * status changed, or it exists on one side only. */
+ * status changed, or it exists on one side only. A metric the baseline has
+ * no value for (the geodesic error, in a baseline older than it) is listed
+ * as unchecked and never drifts. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -53,7 +55,16 @@ static int check_row(const diff_table *t, const tcb_baseline_row *br, const tcb_
         return ok;
     }
     int ok = 1;
-    for (int m = 0; m < TCB_N_METRICS; m++) ok &= check_value(t, row, m, br, cr);
+    for (int m = 0; m < TCB_N_METRICS; m++) {
+        if (br->checked[m]) {
+            ok &= check_value(t, row, m, br, cr);
+            continue;
+        }
+        /* A metric added since the baseline was written: shown, not judged. */
+        char cur[32] = "-";
+        if (cr->has[m]) snprintf(cur, sizeof cur, "%.6f", cr->mean[m]);
+        line(t, row, tcb_rpt_metrics[m].key, "absent", cur, "", "", "unchecked");
+    }
     return ok;
 }
 

@@ -11,7 +11,8 @@
 
 static const char *const TOP_KEYS[] = {"format", "name", "paper", "units", "methods", "tables", NULL};
 static const char *const TABLE_KEYS[] = {"id", "title", "rows", NULL};
-static const char *const ROW_KEYS[] = {"paper_row", "dataset", "sequence", "method", "sl2", "rank", "auc", "cd", NULL};
+static const char *const ROW_KEYS[] = {"paper_row", "dataset", "sequence", "method", "sl2",
+                                       "rank", "auc", "cd", "geo", "geo_auc", NULL};
 
 static int copy(char *dst, size_t cap, const cJSON *o, const char *key, const char *where, tcb_error *err)
 {
@@ -24,11 +25,13 @@ static int copy(char *dst, size_t cap, const cJSON *o, const char *key, const ch
     return TCB_OK;
 }
 
-/* "sl2": null | [mean, std] | [mean, null] */
+/* "sl2": null | [mean, std] | [mean, null]; a metric not of the paper's
+ * protocol (the geodesic error) may be left out, as null. */
 static int parse_value(const cJSON *o, int m, const char *where, tcb_ref_row *r, tcb_error *err)
 {
     const char *key = tcb_rpt_metrics[m].key;
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+    if (!v && !tcb_rpt_metrics[m].paper) return TCB_OK;
     if (!v) return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: required key is missing", where, key);
     if (cJSON_IsNull(v)) return TCB_OK;
     const cJSON *mean = cJSON_GetArrayItem(v, 0), *std = cJSON_GetArrayItem(v, 1);

@@ -1,6 +1,6 @@
-/* `tcbench report`: tables.md, tables.tex, results.csv, by_gap.csv, seeds.csv and two
- * plots per sequence (PCK, m_sL2 by frame distance), each published
- * atomically. */
+/* `tcbench report`: tables.md, tables.tex, results.csv, by_gap.csv, seeds.csv and three
+ * plots per sequence (PCK, geodesic PCK, m_sL2 by frame distance), each
+ * published atomically. */
 #include "tcb/report.h"
 
 #include "reports/chart.h"
@@ -41,7 +41,8 @@ static int write_all(const tcb_rpt *r, const char *dir, tcb_error *err)
         (rc = write_text(dir, "seeds.csv", tcb_rpt_write_seed_csv, r, err)))
         return rc;
     for (int k = 0; k < r->n_blocks && !rc; k++)
-        if (!(rc = write_plot(dir, "pck", tcb_rpt_plot_pck, &r->blocks[k], err)))
+        if (!(rc = write_plot(dir, "pck", tcb_rpt_plot_pck, &r->blocks[k], err)) &&
+            !(rc = write_plot(dir, "pck_geo", tcb_rpt_plot_pck_geo, &r->blocks[k], err)))
             rc = write_plot(dir, "gap", tcb_rpt_plot_gap, &r->blocks[k], err);
     return rc;
 }

@@ -1,6 +1,8 @@
 /* results.csv: one row per (dataset, sequence, method), then each dataset's
  * MEAN rows (sequence "MEAN", role "mean"). Table units, the tables'
- * precision; empty fields where the tables show "-" or a status.
+ * precision; empty fields where the tables show "-" or a status. The
+ * geodesic columns come last (geo_unreachable: vertices scored by the
+ * straight-line fallback, summed over the pooled pairs).
  *
  * by_gap.csv: one row per (dataset, sequence, method, frame distance) that
  * has pairs, for the methods whose cells are all ok.
@@ -40,17 +42,26 @@ static void put_block(FILE *f, const tcb_rpt_block *b, const tcb_rpt_row *r)
     put_field(f, r->method);
 }
 
+static void put_mean_std(FILE *f, const tcb_rpt_row *r, int m)
+{
+    put_num(f, r->has[m], r->mean[m], tcb_rpt_metrics[m].decimals);
+    put_num(f, r->has[m], r->std[m], tcb_rpt_metrics[m].decimals);
+}
+
+/* The paper's metrics and sL2² first, where they always were; the
+ * additions (geodesic) after them, so older readers' columns stay put. */
 static void write_row(FILE *f, const tcb_rpt_block *b, const tcb_rpt_row *r)
 {
     put_block(f, b, r);
     fprintf(f, ",%s,%d,%d", r->status, r->n_seeds, r->n_pairs);
-    for (int m = 0; m < TCB_N_METRICS; m++) {
-        put_num(f, r->has[m], r->mean[m], tcb_rpt_metrics[m].decimals);
-        put_num(f, r->has[m], r->std[m], tcb_rpt_metrics[m].decimals);
-    }
+    for (int m = 0; m < TCB_N_METRICS; m++)
+        if (tcb_rpt_metrics[m].paper) put_mean_std(f, r, m);
     /* sL2² is a squared distance like CD: same precision. */
     put_num(f, r->has[TCB_M_SL2], r->sl2sq_mean, tcb_rpt_metrics[TCB_M_CD].decimals);
     put_num(f, r->has[TCB_M_SL2], r->sl2sq_std, tcb_rpt_metrics[TCB_M_CD].decimals);
+    for (int m = 0; m < TCB_N_METRICS; m++)
+        if (!tcb_rpt_metrics[m].paper) put_mean_std(f, r, m);
+    put_num(f, r->has[TCB_M_GEO], r->geo_unreachable, 0);
     fputc('\n', f);
 }
 
@@ -58,7 +69,8 @@ void tcb_rpt_write_csv(FILE *f, const tcb_rpt *r)
 {
     fputs("dataset,sequence,role,method,status,seeds,n_pairs,sl2_x1e3_mean,sl2_x1e3_std,"
           "rank_pct_mean,rank_pct_std,auc_pct_mean,auc_pct_std,cd_x1e3_mean,cd_x1e3_std,"
-          "sl2sq_x1e3_mean,sl2sq_x1e3_std\n",
+          "sl2sq_x1e3_mean,sl2sq_x1e3_std,geo_x1e3_mean,geo_x1e3_std,geo_auc_pct_mean,"
+          "geo_auc_pct_std,geo_unreachable\n",
           f);
     for (int d = 0; d < r->n_datasets; d++) {
         const tcb_rpt_dataset *ds = &r->datasets[d];
@@ -90,7 +102,7 @@ void tcb_rpt_write_gap_csv(FILE *f, const tcb_rpt *r)
 void tcb_rpt_write_seed_csv(FILE *f, const tcb_rpt *r)
 {
     fputs("dataset,sequence,role,method,seed,status,n_pairs,sl2_x1e3_mean,rank_pct_mean,"
-          "auc_pct_mean,cd_x1e3_mean\n",
+          "auc_pct_mean,cd_x1e3_mean,geo_x1e3_mean,geo_auc_pct_mean\n",
           f);
     for (int k = 0; k < r->n_blocks; k++)
         for (int i = 0; i < r->blocks[k].n_rows; i++) {

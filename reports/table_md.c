@@ -27,6 +27,23 @@ static void fewer_seeds_note(const tcb_rpt_block *b, const tcb_rpt_row *r, char 
     if (used < size) snprintf(out + used, size - used, ")");
 }
 
+/* Rows whose geodesic error scored some vertices by the straight line
+ * (their prediction on another piece of the mesh): how many, so a reader
+ * knows how much of m_geo is not a path. */
+static void write_unreachable_note(FILE *f, const tcb_rpt_block *b)
+{
+    int header = 0;
+    for (int k = 0; k < b->n_rows; k++) {
+        const tcb_rpt_row *r = &b->rows[k];
+        if (!r->has[TCB_M_GEO] || r->geo_unreachable <= 0) continue;
+        if (!header++)
+            fprintf(f, "\nm_geo: vertices predicted on another connected piece of the mesh, "
+                       "scored by their straight-line distance (docs/protocol.md):\n");
+        fprintf(f, "- %s: %.0f of %.0f vertices (%.2f %%)\n", r->method, r->geo_unreachable,
+                r->geo_vertices, 100.0 * r->geo_unreachable / r->geo_vertices);
+    }
+}
+
 static void write_table(FILE *f, const tcb_rpt_block *b)
 {
     fprintf(f, "| method |");
@@ -54,6 +71,7 @@ static void write_table(FILE *f, const tcb_rpt_block *b)
         if (!header++) fprintf(f, "\nNot ok:\n");
         fprintf(f, "- %s: %s — %s\n", r->method, r->status_text, r->message);
     }
+    write_unreachable_note(f, b);
     fprintf(f, "\n");
 }
 
@@ -102,12 +120,14 @@ static void write_seed_table(FILE *f, const tcb_rpt_block *b)
 /* The block's plots, written beside tables.md by the report. */
 static void write_plot_links(FILE *f, const tcb_rpt_block *b)
 {
-    char pck[1024], gap[1024];
+    char pck[1024], geo[1024], gap[1024];
     tcb_error err = {0};
     if (tcb_chart_file_name(b, "pck", pck, sizeof pck, &err) ||
+        tcb_chart_file_name(b, "pck_geo", geo, sizeof geo, &err) ||
         tcb_chart_file_name(b, "gap", gap, sizeof gap, &err))
         return; /* a name too long for a link: the plots are still in the directory */
-    fprintf(f, "![PCK curves](%s) ![m_sL2 by frame distance](%s)\n\n", pck, gap);
+    fprintf(f, "![PCK curves](%s) ![geodesic PCK curves](%s) ![m_sL2 by frame distance](%s)\n\n",
+            pck, geo, gap);
 }
 
 static void write_dataset(FILE *f, const tcb_rpt *r, const tcb_rpt_dataset *d)
@@ -139,6 +159,9 @@ void tcb_rpt_write_md(FILE *f, const tcb_rpt *r)
     fprintf(f, "# tcbench results\n\n"
                "m_sL2 ×1e3, rank %%, AUC %%, CD ×1e3, as mean ± std (m_sL2 and rank over all "
                "vertices of all pairs, AUC and CD over pairs; seeds pooled). Best per column in "
-               "**bold**; \"-\": the method has no reconstruction.\n\n");
+               "**bold**; \"-\": the method has no reconstruction. Beside the paper's metrics, "
+               "the geodesic error (docs/protocol.md): m_geo ×1e3 (path length on the target "
+               "mesh over sqrt(its area), over all vertices of all pairs) and AUC_geo %% (its "
+               "PCK up to 0.25, over pairs); \"-\" there: cells scored before it existed.\n\n");
     for (int k = 0; k < r->n_datasets; k++) write_dataset(f, r, &r->datasets[k]);
 }

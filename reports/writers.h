@@ -19,9 +19,11 @@ void tcb_rpt_write_gap_csv(FILE *f, const tcb_rpt *r);
 /* seeds.csv: each cell's own means. (reports/table_csv.c) */
 void tcb_rpt_write_seed_csv(FILE *f, const tcb_rpt *r);
 
-/* One PNG per block, published atomically at `path`: the PCK curves
- * (reports/plot_pck.c) and m_sL2 by frame distance (reports/plot_gap.c). */
+/* One PNG per block, published atomically at `path`: the PCK curves, the
+ * geodesic PCK curves (reports/plot_pck.c) and m_sL2 by frame distance
+ * (reports/plot_gap.c). */
 int tcb_rpt_plot_pck(const tcb_rpt_block *b, const char *path, tcb_error *err);
+int tcb_rpt_plot_pck_geo(const tcb_rpt_block *b, const char *path, tcb_error *err);
 int tcb_rpt_plot_gap(const tcb_rpt_block *b, const char *path, tcb_error *err);
 
 #endif

@@ -17,8 +17,10 @@
  *   recon_i.ply,     the method's surface samples of frames i and j (only
  *   recon_j.ply      for methods that reconstruct), each point coloured as
  *                    its nearest GT vertex
- *   vertices.csv     k, pred[k], error[k] for every vertex
- *   pair.json        frames, the recomputed metrics, the cell file's row and
+ *   vertices.csv     k, pred[k], error[k] and geodesic[k] (the geodesic
+ *                    error over sqrt(area), tcb/geodesic.h) for every vertex
+ *   pair.json        frames, the target frame's area, the recomputed metrics
+ *                    (geodesic ones included), the cell file's row and
  *                    whether they agree, the colour legend
  *
  * Coordinates are the normalized ones the metrics use. Each file is written

@@ -11,7 +11,10 @@
  *   AUC    = mean_s PCK_s                  (×100)
  *   CD     = mean_a min_b |a−b|² + mean_b min_a |a−b|²   (×1e3)
  * sL2 and rank mean ± std are pooled over all vertices of all pairs; AUC and
- * CD mean ± std are over pairs (numpy std, ddof = 0). */
+ * CD mean ± std are over pairs (numpy std, ddof = 0).
+ *
+ * Beside them, not part of the paper's protocol: the geodesic error m_geo
+ * and its PCK curve (tcb/geodesic.h computes them), pooled the same way. */
 #ifndef TCB_METRICS_H
 #define TCB_METRICS_H
 
@@ -25,6 +28,10 @@ extern "C" {
 
 #define TCB_PCK_STEPS 100
 #define TCB_PCK_MAX 0.02
+/* The geodesic PCK: thresholds on the normalised geodesic error (not
+ * squared), the range of Kim et al. 2011's plots. */
+#define TCB_GEO_PCK_STEPS 100
+#define TCB_GEO_PCK_MAX 0.25
 
 /* Running mean / variance (Welford; Chan et al. to merge). std uses ddof = 0. */
 typedef struct tcb_stat {
@@ -39,6 +46,13 @@ double tcb_stat_std(const tcb_stat *s);
 
 /* Threshold s of the PCK curve: linspace(0, TCB_PCK_MAX, TCB_PCK_STEPS)[s]. */
 double tcb_pck_threshold(int s);
+/* Threshold s of the geodesic PCK: linspace(0, TCB_GEO_PCK_MAX, TCB_GEO_PCK_STEPS)[s]. */
+double tcb_geo_pck_threshold(int s);
+
+/* pck[s] = frac_k [d[k] <= threshold(s)] over d[0 .. n), s < steps; *auc =
+ * mean_s pck[s]. */
+void tcb_pck_curve(const double *d, int n, double (*threshold)(int), int steps, double *pck,
+                   double *auc);
 
 typedef struct tcb_pair_metrics {
     tcb_stat sl2;               /* per-vertex Euclidean error */
@@ -46,6 +60,11 @@ typedef struct tcb_pair_metrics {
     tcb_stat rank;              /* per-vertex normalized rank in [0, 1) */
     double pck[TCB_PCK_STEPS];  /* fractions */
     double auc;                 /* mean of pck, in [0, 1] */
+    /* Geodesic error (tcb_pair_geodesic_compute); geo.n = 0 when not computed. */
+    tcb_stat geo;               /* per-vertex normalised geodesic error */
+    double geo_pck[TCB_GEO_PCK_STEPS];
+    double geo_auc;
+    int geo_unreachable;        /* vertices scored by the Euclidean fallback */
 } tcb_pair_metrics;
 
 /* Step 2 of the transfer: idx[k] = nearest GT vertex of frame j to pts[k]. */
@@ -83,6 +102,12 @@ typedef struct tcb_summary {
     tcb_stat auc;                /* over pairs */
     tcb_stat cd;                 /* over pairs; n = 0 when the method has no reconstruction */
     double pck[TCB_PCK_STEPS];   /* mean curve over pairs */
+    /* Geodesic error, over the pairs that have it (geo_auc.n of them: all
+     * pairs of a cell scored since it exists, none of an older cell). */
+    tcb_stat geo;                /* pooled over all vertices of those pairs */
+    tcb_stat geo_auc;            /* over those pairs */
+    double geo_pck[TCB_GEO_PCK_STEPS]; /* mean curve over those pairs */
+    double geo_unreachable;      /* vertices scored by the Euclidean fallback, summed */
 } tcb_summary;
 
 void tcb_summary_init(tcb_summary *s);

@@ -21,13 +21,21 @@
  *         fit time recorded beside it; peak_rss_kb is this process's)
  *     "split": {"path", "seed", "n_pairs"},
  *     "summary": {"n_pairs", "sl2": {"n","mean","m2"}, "sl2sq": {…},
- *                 "rank": {…}, "auc": {…}, "cd": {…} | null, "pck": [100]},
+ *                 "rank": {…}, "auc": {…}, "cd": {…} | null, "pck": [100],
+ *                 "geo": {…}, "geo_auc": {…}, "geo_pck": [100], "geo_unreachable"},
  *     "pair_columns": ["i","j","n","sl2","sl2_m2","sl2sq","sl2sq_m2",
- *                      "rank","rank_m2","auc","cd"],
+ *                      "rank","rank_m2","auc","cd",
+ *                      "geo","geo_m2","geo_auc","geo_unreachable"],
  *     "pairs": [[…], …] }                    (cd is null without reconstruction)
  * "message" says why a failed or diverged cell failed; a cell written by
  * `tcbench score` (tcb/score.h) says "scored from files" there, with
- * method_impl "scored" and params {"pred_dir": …}. */
+ * method_impl "scored" and params {"pred_dir": …}.
+ * The geodesic keys (tcb/geodesic.h: geo is the normalised geodesic error,
+ * geo_unreachable the count of vertices scored by the Euclidean fallback)
+ * came later in the same format: a cell file without them (the four
+ * summary keys absent, 11 pair columns) still loads, with geo.n = 0 and
+ * geo_auc.n = 0, and reports show "-" for its geodesic columns. A pair's
+ * geodesic columns are null when it has none. */
 #ifndef TCB_RESULTS_H
 #define TCB_RESULTS_H
 
@@ -51,6 +59,9 @@ typedef struct tcb_pair_record {
     tcb_stat sl2, sl2sq, rank; /* over the pair's vertices */
     double auc;
     double cd;                 /* NAN when the method has no reconstruction */
+    tcb_stat geo;              /* normalised geodesic error; n = 0: not scored (an older cell) */
+    double geo_auc;
+    int geo_unreachable;       /* vertices scored by the Euclidean fallback */
 } tcb_pair_record;
 
 typedef struct tcb_cell_result {

@@ -26,8 +26,10 @@ from ._lib import ENV_VAR, TcbError, library, path_bytes
 __all__ = ["TcbError", "pair_metrics", "load_split", "load_sequence", "read_cell", "library_path", "ENV_VAR"]
 
 # Columns of a cell's pair row that a prediction alone does not determine:
-# the frames, and the Chamfer distance of a method's reconstructions.
-_NOT_FROM_PREDICTION = ("i", "j", "cd")
+# the frames, the Chamfer distance of a method's reconstructions, and the
+# geodesic error, which needs frame j's faces (pair_metrics takes vertices
+# only; a cell's rows have it, read_cell gives them).
+_NOT_FROM_PREDICTION = ("i", "j", "cd", "geo", "geo_m2", "geo_auc", "geo_unreachable")
 
 
 def library_path() -> str:
@@ -77,9 +79,10 @@ def pair_metrics(verts_j: ArrayLike, pred_ids: ArrayLike) -> dict:
       thresholds;
     - ``summary``: the pair's row of a cell file, {column: float}, bit for
       bit: n, sl2 (m_sL2, the mean error), sl2_m2, sl2sq, sl2sq_m2, rank,
-      rank_m2, auc, and any column the cell format gains (the frames i, j
-      and the Chamfer distance cd are left out: a prediction does not have
-      them);
+      rank_m2, auc, and any column the cell format gains (the frames i, j,
+      the Chamfer distance cd and the geodesic error geo, geo_m2, geo_auc,
+      geo_unreachable are left out: a prediction does not have them, and
+      the geodesic error needs the frame's faces);
     - ``m_sl2`` and ``auc``: summary["sl2"] and summary["auc"].
     """
     lib = library()

@@ -55,9 +55,12 @@ def ply(path):
 def pair(d):
     return json.load(open(f"{d}/pair.json"))
 
-# oracle: every vertex keeps its colour, no error
+# oracle: every vertex keeps its colour, no error, geodesic or not
 p = pair(oracle)
 assert p["recomputed"]["sl2"] == 0 and p["max_relative_difference"] == 0, p
+assert p["recomputed"]["geo"] == 0 and p["recomputed"]["geo_auc"] == 1, p
+assert p["recomputed"]["geo_unreachable"] == 0, p
+assert all(float(r["geodesic"]) == 0 for r in csv.DictReader(open(f"{oracle}/vertices.csv")))
 _, target, faces = ply(f"{oracle}/target.ply")
 _, moved, _ = ply(f"{oracle}/transfer.ply")
 assert moved == target and len(faces) > 0
@@ -85,6 +88,15 @@ assert abs(mean - p["recomputed"]["sl2"]) <= 1e-9 * max(mean, 1e-12), (mean, p)
 _, moved, _ = ply(f"{nearest}/transfer.ply")
 assert all(moved[k] == pos[int(r["predicted"])] for k, r in enumerate(rows))
 assert worst > 0, "a nearest-vertex transfer between distinct frames is never exact"
+# its geodesic error: 0 exactly where the prediction is right, never below
+# the straight line (over the same sqrt(area)), averaging to the pair's m_geo
+root = p["target_area"] ** 0.5
+for k, r in enumerate(rows):
+    g, e = float(r["geodesic"]), float(r["error"])
+    assert (g == 0) == (int(r["predicted"]) == k), (k, r)
+    assert g >= e / root * (1 - 1e-6), (k, g, e / root)
+mean = sum(float(r["geodesic"]) for r in rows) / len(rows)
+assert abs(mean - p["recomputed"]["geo"]) <= 1e-7 * mean, (mean, p)
 
 # atlas method: the worst pair of its cell, reconstructions written
 p = pair(atlas)

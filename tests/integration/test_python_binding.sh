@@ -141,7 +141,8 @@ assert (seq["pool_size"], seq["input_points"], seq["sampling"]) == (500, 2500, "
 def check_row(m, row, columns, at):
     for c, x in m["summary"].items():
         assert x.hex() == float(row[columns.index(c)]).hex(), (at, c, x, row[columns.index(c)])
-    assert set(m["summary"]) == set(columns) - {"i", "j", "cd"}, m["summary"]
+    assert set(m["summary"]) == set(columns) - {"i", "j", "cd", "geo", "geo_m2", "geo_auc", "geo_unreachable"}, \
+        m["summary"]
     assert m["m_sl2"] == m["summary"]["sl2"] and m["auc"] == m["summary"]["auc"]
 
 cell = tcbench.read_cell("runs/py/cells/synth/quadruped_walk/rnd/seed_0.json")

@@ -16,7 +16,10 @@ trap 'rm -rf "$tmp"' EXIT
 cd "$TCB_SOURCE_DIR"   # the committed splits/ are reused, never rewritten
 
 "$TCBENCH" run configs/quick.json --out "$tmp/run" --quiet
-"$TCBENCH" check "$tmp/run" tests/baselines/quick.json
+"$TCBENCH" check "$tmp/run" tests/baselines/quick.json > "$tmp/check.txt" || { cat "$tmp/check.txt"; exit 1; }
+cat "$tmp/check.txt"
+# The baseline carries the geodesic error too: nothing left unchecked.
+if grep -q unchecked "$tmp/check.txt"; then echo "FAIL: geodesic values missing from the baseline"; exit 1; fi
 
 /usr/bin/python3 - "$tmp/run" <<'PY'
 import glob, json, sys
@@ -26,11 +29,17 @@ for c in cells:
     s = c["summary"]
     assert c["status"] == "ok", c["message"]
     assert s["n_pairs"] == 500
+    # every vertex of every pair has a geodesic error; the synthetic meshes
+    # are closed and in one piece, so none falls back to the straight line
+    assert s["geo"]["n"] == s["sl2"]["n"] and s["geo_auc"]["n"] == 500, s
+    assert s["geo_unreachable"] == 0, s
     if c["method"] == "oracle":
         assert s["sl2"]["mean"] == 0 and s["rank"]["mean"] == 0 and s["auc"]["mean"] == 1, s
+        assert s["geo"]["mean"] == 0 and s["geo_auc"]["mean"] == 1, s
     elif c["method"] == "cc":
         assert c["timings"]["fit_s"] > 0 and s["cd"] is None, c
     else:
         assert s["sl2"]["mean"] > 0 and s["auc"]["mean"] < 1, s
+        assert s["geo"]["mean"] > 0 and s["geo_auc"]["mean"] < 1, s
 print("quick config: %d cells ok" % len(cells))
 PY

@@ -79,7 +79,11 @@ for method, scored in [("oracle", ["oracle_i32", "oracle_i64_be", "oracle_f8_F"]
         c = cell(s)
         assert c["summary"] == ref["summary"], (s, c["summary"]["sl2"], ref["summary"]["sl2"])
         assert c["pairs"] == ref["pairs"], s
-        assert c["summary"]["cd"] is None and all(p[-1] is None for p in c["pairs"]), s
+        cols = c["pair_columns"]
+        assert c["summary"]["cd"] is None and all(p[cols.index("cd")] is None for p in c["pairs"]), s
+        # the geodesic error comes the same way (equal to the method's above)
+        assert c["summary"]["geo_auc"]["n"] == 20 and c["summary"]["geo"]["n"] == c["summary"]["sl2"]["n"], s
+        assert (c["summary"]["geo"]["mean"] == 0) == (method == "oracle"), s
         for key in ("format", "dataset", "sequence", "role", "split", "status"):
             assert c[key] == ref[key], (s, key, c[key], ref[key])
         assert (c["method"], c["method_impl"], c["params"], c["message"], c["seed"]) == \
@@ -90,7 +94,7 @@ PY
 
 # ---- report and check take the scored rows like any other
 expect 0 "" "$TCBENCH" report runs/tiny --quiet
-grep -qE '^\| nearest_u2 \| 11\.[0-9]+ ± [0-9.]+ \| .* \| - \|$' runs/tiny/report/tables.md ||
+grep -qE '^\| nearest_u2 \| 11\.[0-9]+ ± [0-9.]+ \| .* \| - \| [0-9.]+ ± [0-9.]+ \| [0-9.]+ ± [0-9.]+ \|$' runs/tiny/report/tables.md ||
     { echo "FAIL: no nearest_u2 row"; cat runs/tiny/report/tables.md; exit 1; }
 expect 0 "baseline written" "$TCBENCH" check runs/tiny base.json --update
 expect 0 "synth/quadruped_walk/nearest_f4" "$TCBENCH" check runs/tiny base.json

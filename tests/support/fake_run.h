@@ -23,6 +23,7 @@ typedef struct fake_cell {
     tcb_cell_status status;
     double base;  /* scales the method's errors: lower is better */
     int has_cd;   /* the method reconstructs */
+    int no_geo;   /* written as before the geodesic error existed: none */
 } fake_cell;
 
 /* Per-vertex Euclidean error of vertex k in pair p. */
@@ -36,6 +37,29 @@ static inline double fake_sl2(const fake_cell *c, int p, int k)
 static inline double fake_rank(int k) { return 0.01 * (k + 1); }
 
 static inline double fake_cd(const fake_cell *c, int p) { return c->base * 0.01 * (1 + p); }
+
+/* Normalised geodesic error of vertex k in pair p: above the Euclidean one,
+ * spread over the geodesic PCK's range. */
+static inline double fake_geo(const fake_cell *c, int p, int k)
+{
+    return c->base * (2.0 + 0.1937 * k + 0.3113 * p + 0.1013 * c->seed);
+}
+
+/* Vertices scored by the straight-line fallback: one in the second pair of
+ * a method without reconstruction, none elsewhere. */
+static inline int fake_unreachable(const fake_cell *c, int p) { return c->has_cd ? 0 : p; }
+
+static inline void fake_pair_geo(const fake_cell *c, int p, tcb_pair_metrics *m)
+{
+    for (int k = 0; k < FAKE_NV; k++) tcb_stat_push(&m->geo, fake_geo(c, p, k));
+    for (int s = 0; s < TCB_GEO_PCK_STEPS; s++) {
+        int hits = 0;
+        for (int k = 0; k < FAKE_NV; k++) hits += fake_geo(c, p, k) <= tcb_geo_pck_threshold(s);
+        m->geo_pck[s] = (double)hits / FAKE_NV;
+        m->geo_auc += m->geo_pck[s] / TCB_GEO_PCK_STEPS;
+    }
+    m->geo_unreachable = fake_unreachable(c, p);
+}
 
 static inline void fake_pair(const fake_cell *c, int p, tcb_pair_metrics *m)
 {
@@ -52,6 +76,7 @@ static inline void fake_pair(const fake_cell *c, int p, tcb_pair_metrics *m)
         m->pck[s] = (double)hits / FAKE_NV;
         m->auc += m->pck[s] / TCB_PCK_STEPS;
     }
+    if (!c->no_geo) fake_pair_geo(c, p, m);
 }
 
 /* Pair p's frames: (0, 1) and (3, 1), frame distances 1 and 2 (both orders). */
@@ -84,7 +109,8 @@ static inline int fake_write(const char *run, const fake_cell *c)
             tcb_pair_metrics m;
             fake_pair(c, p, &m);
             double cd = c->has_cd ? fake_cd(c, p) : NAN;
-            pairs[p] = (tcb_pair_record){fake_i(p), fake_j(p), m.sl2, m.sl2sq, m.rank, m.auc, cd};
+            pairs[p] = (tcb_pair_record){fake_i(p), fake_j(p), m.sl2,    m.sl2sq,   m.rank,
+                                         m.auc,     cd,        m.geo,    m.geo_auc, m.geo_unreachable};
             tcb_summary_add_pair(&r.summary, &m, cd);
         }
     } else {

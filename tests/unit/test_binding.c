@@ -53,7 +53,8 @@ static void test_info(void **state)
 }
 
 /* The row equals the record a cell gets for the same prediction, bit for
- * bit (the frames and the Chamfer distance left NaN); sq, rank and pck are
+ * bit (the frames and the Chamfer distance left NaN, and the geodesic
+ * error, which needs faces the binding is not given); sq, rank and pck are
  * the values behind it. */
 static void test_pair_metrics_is_the_cells_row(void **state)
 {
@@ -70,17 +71,25 @@ static void test_pair_metrics_is_the_cells_row(void **state)
     assert_int_equal(tcb_binding_pair_metrics(v, K, pred, sq, rank, pck, TCB_PCK_STEPS, row, TCB_N_PAIR_COLUMNS,
                                               &err), TCB_OK);
 
-    tcb_sequence one = {.n_frames = 1, .n_verts = K, .verts = v};
-    tcb_pair_prediction p = {4, 0, NULL, pred, NAN};
+    /* a frame of points without faces: the cell's geodesic error falls back
+     * to the straight line everywhere (area 1), the binding has none */
+    double area = 1.0;
+    tcb_sequence one = {.n_frames = 1, .n_verts = K, .verts = v, .areas = &area};
+    tcb_pair_prediction p = {4, 0, NULL, pred, NAN, NULL};
     tcb_pair_record rec;
     tcb_summary sum;
     tcb_pair_metrics m;
+    tcb_pair_scorer scorer;
     tcb_summary_init(&sum);
-    assert_int_equal(tcb_cell_score_pair(&one, &p, &rec, &sum, &m, &err), TCB_OK);
+    assert_int_equal(tcb_pair_scorer_init(&scorer, &one, &err), TCB_OK);
+    assert_int_equal(tcb_cell_score_pair(&scorer, &p, &rec, &sum, &m, &err), TCB_OK);
+    tcb_pair_scorer_free(&scorer);
     double want[TCB_N_PAIR_COLUMNS];
     tcb_pair_record_row(&rec, want);
-    assert_true(isnan(row[0]) && isnan(row[1]) && isnan(row[TCB_N_PAIR_COLUMNS - 1]));
-    assert_memory_equal(row + 2, want + 2, (TCB_N_PAIR_COLUMNS - 3) * sizeof *row);
+    enum { CD = TCB_N_PAIR_COLUMNS_EUCLIDEAN - 1 };
+    assert_true(isnan(row[0]) && isnan(row[1]) && isnan(row[CD]) && isnan(want[CD]));
+    assert_memory_equal(row + 2, want + 2, (CD - 2) * sizeof *row);
+    for (int c = CD + 1; c < TCB_N_PAIR_COLUMNS; c++) assert_true(isnan(row[c]) && !isnan(want[c]));
     assert_memory_equal(pck, m.pck, sizeof pck);
 
     double sq_want[K], rank_want[K];

@@ -23,11 +23,11 @@ typedef struct fixture {
 } fixture;
 
 static const fake_cell CELLS[] = {
-    {"anim", "cat", "validation", "AN", 0, TCB_CELL_OK, 0.03, 1},
-    {"anim", "horse", "test", "AN", 0, TCB_CELL_OK, 0.01, 1},
-    {"anim", "horse", "test", "AN", 1, TCB_CELL_OK, 0.01, 1},
-    {"anim", "horse", "test", "NN", 0, TCB_CELL_OK, 0.02, 0},
-    {"anim", "horse", "test", "DSR", 0, TCB_CELL_DIVERGED, 0.01, 1},
+    {"anim", "cat", "validation", "AN", 0, TCB_CELL_OK, 0.03, 1, 0},
+    {"anim", "horse", "test", "AN", 0, TCB_CELL_OK, 0.01, 1, 0},
+    {"anim", "horse", "test", "AN", 1, TCB_CELL_OK, 0.01, 1, 0},
+    {"anim", "horse", "test", "NN", 0, TCB_CELL_OK, 0.02, 0, 0},
+    {"anim", "horse", "test", "DSR", 0, TCB_CELL_DIVERGED, 0.01, 1, 0},
 };
 #define N_CELLS ((int)(sizeof CELLS / sizeof CELLS[0]))
 
@@ -116,10 +116,23 @@ static void test_baseline_checks_clean(void **state)
     free(table);
 }
 
-static void shift(cJSON *row, double by)
+static void shift_metric(cJSON *row, const char *metric, double by)
 {
-    cJSON *v = cJSON_GetObjectItem(row, "sl2");
+    cJSON *v = cJSON_GetObjectItem(row, metric);
     cJSON_SetNumberValue(v, v->valuedouble + by);
+}
+static void shift(cJSON *row, double by) { shift_metric(row, "sl2", by); }
+
+/* Checks the baseline at path: exactly one row drifts, on one line, which
+ * contains every one of the n needles. */
+static void expect_one_drift(const fixture *f, const char *path, int n, const char *const *needles)
+{
+    char *table, lines[8][256];
+    assert_int_equal(check(f, path, &table), 1);
+    assert_int_equal(drift_lines(table, lines, 8), 1);
+    for (int k = 0; k < n; k++)
+        if (!strstr(lines[0], needles[k])) fail_msg("no \"%s\" in: %s", needles[k], lines[0]);
+    free(table);
 }
 static void beyond_tolerance(cJSON *root, cJSON *row) { (void)root, shift(row, 1e-3); }
 static void within_tolerance(cJSON *root, cJSON *row) { (void)root, shift(row, 5e-7); }
@@ -127,14 +140,9 @@ static void within_tolerance(cJSON *root, cJSON *row) { (void)root, shift(row, 5
 static void test_drift_beyond_tolerance(void **state)
 {
     fixture *f = *state;
-    char path[2048], *table, lines[8][256];
+    char path[2048], *table;
     edited(f, "horse", "AN", beyond_tolerance, "beyond.json", path, sizeof path);
-    assert_int_equal(check(f, path, &table), 1);
-    assert_int_equal(drift_lines(table, lines, 8), 1);
-    assert_non_null(strstr(lines[0], "anim/horse/AN "));
-    assert_non_null(strstr(lines[0], " sl2 "));
-    assert_non_null(strstr(lines[0], "-1.000e-03"));
-    free(table);
+    expect_one_drift(f, path, 3, (const char *const[]){"anim/horse/AN ", " sl2 ", "-1.000e-03"});
     edited(f, "horse", "AN", within_tolerance, "within.json", path, sizeof path);
     assert_int_equal(check(f, path, &table), 0);
     free(table);
@@ -261,6 +269,65 @@ static void test_missing_and_extra_rows_drift(void **state)
     assert_int_equal(fake_write(f->dir, &CELLS[0]), 0);
 }
 
+/* The geodesic error drifts like any metric. */
+static void geo_moves(cJSON *root, cJSON *row) { (void)root, shift_metric(row, "geo", 1e-3); }
+
+/* A baseline written before the geodesic error: no geodesic values, no
+ * geodesic tolerances. */
+static void strip_geodesic(cJSON *root, cJSON *row)
+{
+    (void)row;
+    cJSON *t = cJSON_GetObjectItem(root, "tolerances"), *r;
+    cJSON_DeleteItemFromObject(t, "geo");
+    cJSON_DeleteItemFromObject(t, "geo_auc");
+    cJSON_ArrayForEach(r, cJSON_GetObjectItem(root, "rows"))
+    {
+        cJSON_DeleteItemFromObject(r, "geo");
+        cJSON_DeleteItemFromObject(r, "geo_auc");
+    }
+}
+static void strip_geodesic_and_shift(cJSON *root, cJSON *row)
+{
+    strip_geodesic(root, row);
+    shift(row, 1e-3);
+}
+
+static int count(const char *text, const char *needle)
+{
+    int n = 0;
+    for (const char *p = text; (p = strstr(p, needle)); p++) n++;
+    return n;
+}
+
+static void test_geodesic(void **state)
+{
+    fixture *f = *state;
+    char path[2048], *table, lines[8][256];
+    edited(f, "horse", "AN", geo_moves, "geo.json", path, sizeof path);
+    expect_one_drift(f, path, 2, (const char *const[]){"anim/horse/AN ", " geo "});
+    /* An old baseline still checks the paper's metrics, lists the
+     * geodesic ones as unchecked and finds no drift; it still catches a
+     * moved m_sL2. */
+    edited(f, "horse", "AN", strip_geodesic, "old.json", path, sizeof path);
+    assert_int_equal(check(f, path, &table), 0);
+    assert_int_equal(count(table, "unchecked"), 2 * 3); /* geo, geo_auc of the 3 ok rows */
+    assert_non_null(strstr(table, " sl2 "));
+    free(table);
+    edited(f, "horse", "AN", strip_geodesic_and_shift, "old_moved.json", path, sizeof path);
+    expect_one_drift(f, path, 2, (const char *const[]){"anim/horse/AN ", " sl2 "});
+    /* A run whose cell has no geodesic values (written before them) drifts
+     * against a baseline that has them. */
+    fake_cell old = CELLS[1];
+    old.no_geo = 1;
+    assert_int_equal(fake_write(f->dir, &old), 0);
+    assert_int_equal(check(f, f->baseline, &table), 1);
+    assert_int_equal(drift_lines(table, lines, 8), 2);
+    assert_non_null(strstr(lines[0], " geo "));
+    assert_non_null(strstr(lines[1], " geo_auc "));
+    free(table);
+    assert_int_equal(fake_write(f->dir, &CELLS[1]), 0);
+}
+
 static void expect_malformed(const fixture *f, const char *text, const char *key)
 {
     char path[2048];
@@ -315,6 +382,7 @@ int main(void)
         cmocka_unit_test(test_row_tolerance),
         cmocka_unit_test(test_null_and_status_mismatch_drift),
         cmocka_unit_test(test_missing_and_extra_rows_drift),
+        cmocka_unit_test(test_geodesic),
         cmocka_unit_test(test_malformed_baselines),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

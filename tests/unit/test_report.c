@@ -48,20 +48,25 @@ static fake_cell cell_of(int s, int m, int seed)
     const method_spec *p = &METHODS[m];
     int failed = !strcmp(p->name, "DSR") && !strcmp(q->name, "camel");
     return (fake_cell){q->dataset, q->name, q->role, p->name, seed,
-                       failed ? TCB_CELL_FAILED : TCB_CELL_OK, p->base * q->scale, p->has_cd};
+                       failed ? TCB_CELL_FAILED : TCB_CELL_OK, p->base * q->scale, p->has_cd, 0};
 }
 
 /* Expected table values of (sequence, method): [metric] mean and std in
- * table units, pooled over seeds by hand. */
+ * table units, pooled over seeds by hand: m_sL2, rank, AUC, CD, m_geo,
+ * AUC_geo; and the vertices scored by the geodesic fallback. */
+#define N_COLS 6
 typedef struct expect {
-    double mean[4], std[4];
+    double mean[N_COLS], std[N_COLS];
+    int unreachable;
 } expect;
 
 static expect expected_seeds(int s, int m, int first_seed, int n_seeds)
 {
     double sl2[8 * FAKE_PAIRS * FAKE_NV], rank[8 * FAKE_PAIRS * FAKE_NV];
-    double auc[8 * FAKE_PAIRS], cd[8 * FAKE_PAIRS];
+    double geo[8 * FAKE_PAIRS * FAKE_NV], auc[8 * FAKE_PAIRS], cd[8 * FAKE_PAIRS];
+    double geo_auc[8 * FAKE_PAIRS];
     int nv = 0, np = 0;
+    expect e = {{0}, {0}, 0};
     for (int seed = first_seed; seed < first_seed + n_seeds; seed++) {
         fake_cell c = cell_of(s, m, seed);
         for (int p = 0; p < FAKE_PAIRS; p++, np++) {
@@ -69,19 +74,23 @@ static expect expected_seeds(int s, int m, int first_seed, int n_seeds)
             fake_pair(&c, p, &pm);
             auc[np] = pm.auc;
             cd[np] = fake_cd(&c, p);
+            geo_auc[np] = pm.geo_auc;
+            e.unreachable += fake_unreachable(&c, p);
             for (int k = 0; k < FAKE_NV; k++, nv++) {
                 sl2[nv] = fake_sl2(&c, p, k);
                 rank[nv] = fake_rank(k);
+                geo[nv] = fake_geo(&c, p, k);
             }
         }
     }
-    expect e;
     fake_mean_std(sl2, nv, &e.mean[0], &e.std[0]);
     fake_mean_std(rank, nv, &e.mean[1], &e.std[1]);
     fake_mean_std(auc, np, &e.mean[2], &e.std[2]);
     fake_mean_std(cd, np, &e.mean[3], &e.std[3]);
-    static const double scale[4] = {1e3, 1e2, 1e2, 1e3};
-    for (int k = 0; k < 4; k++) e.mean[k] *= scale[k], e.std[k] *= scale[k];
+    fake_mean_std(geo, nv, &e.mean[4], &e.std[4]);
+    fake_mean_std(geo_auc, np, &e.mean[5], &e.std[5]);
+    static const double scale[N_COLS] = {1e3, 1e2, 1e2, 1e3, 1e3, 1e2};
+    for (int k = 0; k < N_COLS; k++) e.mean[k] *= scale[k], e.std[k] *= scale[k];
     return e;
 }
 
@@ -91,22 +100,23 @@ static expect expected(int s, int m) { return expected_seeds(s, m, 0, METHODS[m]
  * separately). */
 static expect expected_mean(const int *seqs, int n, int m)
 {
-    expect e = {{0}, {0}};
+    expect e = {{0}, {0}, 0};
     for (int k = 0; k < n; k++) {
         expect s = expected(seqs[k], m);
-        for (int j = 0; j < 4; j++) e.mean[j] += s.mean[j] / n, e.std[j] += s.std[j] / n;
+        for (int j = 0; j < N_COLS; j++) e.mean[j] += s.mean[j] / n, e.std[j] += s.std[j] / n;
+        e.unreachable += s.unreachable;
     }
     return e;
 }
 
-static const int DECIMALS[4] = {2, 2, 2, 3};
+static const int DECIMALS[N_COLS] = {2, 2, 2, 3, 2, 2};
 
-/* "| AN | **1.00 ± 0.20** | … |" with `bold` a 4-bit mask and `no_cd` "-". */
+/* "| AN | **1.00 ± 0.20** | … |" with `bold` a 6-bit mask and `no_cd` "-". */
 static void md_row(const char *method, const expect *e, int bold, int no_cd, char *out,
                    size_t size)
 {
     size_t used = (size_t)snprintf(out, size, "| %s |", method);
-    for (int j = 0; j < 4; j++) {
+    for (int j = 0; j < N_COLS; j++) {
         const char *b = bold >> j & 1 ? "**" : "";
         if (j == 3 && no_cd)
             used += (size_t)snprintf(out + used, size - used, " - |");
@@ -116,7 +126,9 @@ static void md_row(const char *method, const expect *e, int bold, int no_cd, cha
     }
 }
 
-static char *read_all(const char *path)
+/* Not inlined: GCC 12 inlining it next to strstr on its result warns of a
+ * dangling pointer to its local `text` (a false positive). */
+__attribute__((noinline)) static char *read_all(const char *path)
 {
     char *text;
     tcb_error err = {0};
@@ -200,13 +212,17 @@ static void test_md_sequence_block_bold_and_dash(void **state)
     assert_contains(horse, row);
     md_row("NN (seed 0)", &nn, 0x2, 1, row, sizeof row);
     assert_contains(horse, row);
-    md_row("DSR (seed 0)", &dsr, 0xF, 0, row, sizeof row);
+    md_row("DSR (seed 0)", &dsr, 0x3F, 0, row, sizeof row);
     assert_contains(horse, row);
     assert_null(strstr(horse, "| AN ("));
     assert_contains(horse, "role: test · pairs: 2 · seeds: 0, 1");
     /* Links to the block's plots, which test_pngs_are_valid finds on disk. */
     assert_contains(horse, "![PCK curves](pck_anim_horse.png) "
+                           "![geodesic PCK curves](pck_geo_anim_horse.png) "
                            "![m_sL2 by frame distance](gap_anim_horse.png)");
+    /* NN's second pair has a vertex scored by the straight line: said. */
+    assert_contains(horse, "- NN: 1 of 10 vertices (10.00 %)");
+    assert_null(strstr(horse, "- AN: 0 of"));
     free(horse);
 }
 
@@ -214,7 +230,8 @@ static void test_md_failed_method_shows_status(void **state)
 {
     fixture *f = *state;
     char *camel = section(f->md, "### anim / camel");
-    assert_contains(camel, "| DSR (seed 0) | *failed* | *failed* | *failed* | *failed* |");
+    assert_contains(camel, "| DSR (seed 0) | *failed* | *failed* | *failed* | *failed* | *failed* "
+                           "| *failed* |");
     assert_contains(camel, "- DSR: failed — seed 0: loss became NaN at iteration 7");
     free(camel);
 }
@@ -228,16 +245,17 @@ static void test_md_mean_over_test_sequences_only(void **state)
     expect an = expected_mean(tests, 2, 0), nn = expected_mean(tests, 2, 1);
     /* AN best on m_sL2 and AUC, rank tied with NN; CD is AN's alone (NN has
      * none, DSR failed), so not bold. */
-    md_row("AN", &an, 0x7, 0, row, sizeof row);
+    md_row("AN", &an, 0x37, 0, row, sizeof row);
     assert_contains(mean, row);
     md_row("NN", &nn, 0x2, 1, row, sizeof row);
     assert_contains(mean, row);
     /* The validation sequence must not leak into the mean. */
     expect with_cat = expected_mean(all, 3, 0);
-    md_row("AN", &with_cat, 0x7, 0, row, sizeof row);
+    md_row("AN", &with_cat, 0x37, 0, row, sizeof row);
     assert_null(strstr(mean, row));
     /* A method failed on one test sequence gets no MEAN numbers. */
-    assert_contains(mean, "| DSR | *failed* | *failed* | *failed* | *failed* |");
+    assert_contains(mean, "| DSR | *failed* | *failed* | *failed* | *failed* | *failed* | *failed* |");
+    assert_contains(mean, "- NN: 2 of 20 vertices (10.00 %)");
     assert_contains(mean, "- DSR: failed (1/2 test sequences) — camel: seed 0: loss became NaN");
     assert_contains(mean, "2 test sequences (camel, horse)");
     free(mean);
@@ -247,12 +265,12 @@ static void test_md_mean_over_test_sequences_only(void **state)
     free(ama);
 }
 
-/* "| 1 | AN | **1.23** | … |": one cell's means, `bold` a 4-bit mask. */
+/* "| 1 | AN | **1.23** | … |": one cell's means, `bold` a 6-bit mask. */
 static void md_seed_row(int seed, const char *method, const expect *e, int bold, int no_cd,
                         char *out, size_t size)
 {
     size_t used = (size_t)snprintf(out, size, "| %d | %s |", seed, method);
-    for (int j = 0; j < 4; j++) {
+    for (int j = 0; j < N_COLS; j++) {
         const char *b = bold >> j & 1 ? "**" : "";
         if (j == 3 && no_cd)
             used += (size_t)snprintf(out + used, size - used, " - |");
@@ -276,7 +294,7 @@ static void test_md_per_seed_table(void **state)
     assert_contains(horse, row);
     md_seed_row(0, "NN", &nn0, 0x2, 1, row, sizeof row);
     assert_contains(horse, row);
-    md_seed_row(0, "DSR", &dsr0, 0xF, 0, row, sizeof row);
+    md_seed_row(0, "DSR", &dsr0, 0x3F, 0, row, sizeof row);
     assert_contains(horse, row);
     md_seed_row(1, "AN", &an1, 0x0, 0, row, sizeof row);
     assert_contains(horse, row);
@@ -284,7 +302,7 @@ static void test_md_per_seed_table(void **state)
     assert_true(strstr(horse, "| 0 | NN |") < strstr(horse, "| 1 | AN |"));
     free(horse);
     char *camel = section(f->md, "### anim / camel");
-    assert_contains(camel, "| 0 | DSR | *failed* | *failed* | *failed* | *failed* |");
+    assert_contains(camel, "| 0 | DSR | *failed* | *failed* | *failed* | *failed* | *failed* | *failed* |");
     free(camel);
     char *mean = section(f->md, "### anim / MEAN");
     assert_null(strstr(mean, "Per seed"));
@@ -293,8 +311,9 @@ static void test_md_per_seed_table(void **state)
 
 /* ------------------------------------------------------------------ CSV */
 
+#define CSV_MAX_FIELDS 22
 typedef struct csv_row {
-    char field[17][64];
+    char field[CSV_MAX_FIELDS][64];
 } csv_row;
 
 /* Plain comma splitting: the fake run's names need no CSV quoting. Every
@@ -308,7 +327,7 @@ static int parse_csv(const char *text, int n_fields, csv_row *rows, int max)
         for (;; f++) {
             const char *stop = p;
             while (stop < end && *stop != ',') stop++;
-            if (f < 17) snprintf(rows[n].field[f], 64, "%.*s", (int)(stop - p), p);
+            if (f < CSV_MAX_FIELDS) snprintf(rows[n].field[f], 64, "%.*s", (int)(stop - p), p);
             if (stop == end) break;
             p = stop + 1;
         }
@@ -339,10 +358,13 @@ static const csv_row *find_csv(const csv_row *rows, int n, const char *seq, cons
     return NULL;
 }
 
+/* results.csv: the paper's metrics from field 7, sL2² at 15 and 16, the
+ * geodesic ones from 17, the fallback count at 21. */
 static void assert_csv_values(const csv_row *r, const expect *e, int has_cd)
 {
-    for (int j = 0; j < 4; j++) {
-        const char *mean = r->field[7 + 2 * j], *std = r->field[8 + 2 * j];
+    for (int j = 0; j < N_COLS; j++) {
+        int at = j < 4 ? 7 + 2 * j : 17 + 2 * (j - 4);
+        const char *mean = r->field[at], *std = r->field[at + 1];
         if (j == 3 && !has_cd) {
             assert_string_equal(mean, "");
             assert_string_equal(std, "");
@@ -352,16 +374,20 @@ static void assert_csv_values(const csv_row *r, const expect *e, int has_cd)
         assert_true(fabs(strtod(mean, NULL) - e->mean[j]) <= half_ulp);
         assert_true(fabs(strtod(std, NULL) - e->std[j]) <= half_ulp);
     }
+    assert_int_equal(atoi(r->field[21]), e->unreachable);
 }
 
 static void test_csv_parses_back(void **state)
 {
     fixture *f = *state;
     int n;
-    csv_row *rows = read_csv(f, "results.csv", 17, &n);
+    csv_row *rows = read_csv(f, "results.csv", 22, &n);
     /* header + 4 sequences × 3 methods + anim's 3 MEAN rows */
     assert_int_equal(n, 1 + 12 + 3);
     assert_string_equal(rows[0].field[7], "sl2_x1e3_mean");
+    assert_string_equal(rows[0].field[15], "sl2sq_x1e3_mean");
+    assert_string_equal(rows[0].field[17], "geo_x1e3_mean");
+    assert_string_equal(rows[0].field[21], "geo_unreachable");
     expect an = expected(1, 0), nn = expected(1, 1);
     const csv_row *r = find_csv(rows, n, "horse", "AN");
     assert_string_equal(r->field[2], "test");
@@ -443,7 +469,7 @@ static void test_seed_csv_one_row_per_cell(void **state)
 {
     fixture *f = *state;
     int n;
-    csv_row *rows = read_csv(f, "seeds.csv", 11, &n);
+    csv_row *rows = read_csv(f, "seeds.csv", 13, &n);
     assert_string_equal(rows[0].field[4], "seed");
     int n_cells = 0;
     for (int m = 0; m < N_METHODS; m++) n_cells += N_SEQS * METHODS[m].n_seeds;
@@ -463,12 +489,12 @@ static void test_seed_csv_one_row_per_cell(void **state)
                 assert_int_equal(atoi(r->field[6]), c.status == TCB_CELL_OK ? FAKE_PAIRS : 0);
                 if (c.status != TCB_CELL_OK) {
                     assert_string_equal(r->field[5], "failed");
-                    for (int j = 0; j < 4; j++) assert_string_equal(r->field[7 + j], "");
+                    for (int j = 0; j < N_COLS; j++) assert_string_equal(r->field[7 + j], "");
                     continue;
                 }
                 assert_string_equal(r->field[5], "ok");
                 expect e = expected_seeds(s, m, seed, 1);
-                for (int j = 0; j < 4; j++) {
+                for (int j = 0; j < N_COLS; j++) {
                     if (j == 3 && !METHODS[m].has_cd) {
                         assert_string_equal(r->field[7 + j], "");
                         continue;
@@ -492,6 +518,8 @@ static void test_tex_uses_booktabs(void **state)
     assert_contains(tex, "\\midrule");
     assert_contains(tex, "\\bottomrule");
     assert_contains(tex, "m\\_sL2 $\\downarrow$");
+    assert_contains(tex, "m\\_geo $\\downarrow$ & AUC\\_geo $\\uparrow$ \\\\");
+    assert_contains(tex, "\\begin{tabular}{llcccccc}");
     expect dsr = expected(1, 2);
     char best[128];
     snprintf(best, sizeof best, "\\textbf{%.2f $\\pm$ %.2f}", dsr.mean[0], dsr.std[0]);
@@ -508,9 +536,10 @@ static void test_pngs_are_valid(void **state)
 {
     fixture *f = *state;
     static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    for (int s = 0; s < 2 * N_SEQS; s++) {
+    static const char *const kinds[] = {"pck", "pck_geo", "gap"};
+    for (int s = 0; s < 3 * N_SEQS; s++) {
         char path[4096];
-        snprintf(path, sizeof path, "%s/%s_%s_%s.png", f->report, s < N_SEQS ? "pck" : "gap",
+        snprintf(path, sizeof path, "%s/%s_%s_%s.png", f->report, kinds[s / N_SEQS],
                  SEQS[s % N_SEQS].dataset, SEQS[s % N_SEQS].name);
         FILE *fp = fopen(path, "rb");
         assert_non_null(fp);
@@ -532,7 +561,60 @@ static void test_pngs_are_valid(void **state)
         n++;
     }
     closedir(d);
-    assert_int_equal(n, 5 + 2 * N_SEQS);
+    assert_int_equal(n, 5 + 3 * N_SEQS);
+}
+
+/* The Markdown row of `method` in md (up to its line's end). */
+static char *md_line(const char *md, const char *method)
+{
+    char head[96];
+    snprintf(head, sizeof head, "\n| %s |", method);
+    const char *at = strstr(md, head);
+    assert_non_null(at);
+    size_t from = (size_t)(at - md) + 1, len = strcspn(md + from, "\n");
+    char *line = malloc(len + 1);
+    memcpy(line, md + from, len);
+    line[len] = '\0';
+    return line;
+}
+
+static int ends_with(const char *s, const char *tail)
+{
+    size_t n = strlen(s), m = strlen(tail);
+    return n >= m && !strcmp(s + n - m, tail);
+}
+
+/* Cells written before the geodesic error: "-" in its columns, the
+ * paper's numbers as before; a method pooling an old and a new seed has
+ * no geodesic numbers either (not a part passed off as the whole). */
+static void test_old_cells_show_dash(void **state)
+{
+    (void)state;
+    char dir[512];
+    tu_make_tmpdir(dir, sizeof dir);
+    const fake_cell cells[] = {
+        {"anim", "horse", "test", "OLD", 0, TCB_CELL_OK, 0.01, 1, 1},
+        {"anim", "horse", "test", "NEW", 0, TCB_CELL_OK, 0.02, 1, 0},
+        {"anim", "horse", "test", "MIX", 0, TCB_CELL_OK, 0.03, 1, 0},
+        {"anim", "horse", "test", "MIX", 1, TCB_CELL_OK, 0.03, 1, 1},
+    };
+    for (int k = 0; k < 4; k++) assert_int_equal(fake_write(dir, &cells[k]), 0);
+    tcb_error err = {0};
+    assert_int_equal(tcb_report_write(dir, NULL, NULL, &err), TCB_OK);
+    char path[4096];
+    snprintf(path, sizeof path, "%s/report/tables.md", dir);
+    char *md = read_all(path);
+    /* (OLD and NEW ran one of the block's two seeds, which their rows say) */
+    char *old = md_line(md, "OLD (seed 0)"), *neu = md_line(md, "NEW (seed 0)"), *mix = md_line(md, "MIX");
+    /* OLD: best on the paper's m_sL2, "-" for the geodesic error */
+    if (strncmp(old, "| OLD (seed 0) | **", 19) || !ends_with(old, " | - | - |")) fail_msg("%s", old);
+    if (!ends_with(mix, " | - | - |")) fail_msg("%s", mix);
+    /* NEW alone has geodesic numbers, with nothing to compare: not bold */
+    if (strstr(neu, "| - |") || ends_with(neu, "** |")) fail_msg("%s", neu);
+    snprintf(path, sizeof path, "%s/report/pck_geo_anim_horse.png", dir);
+    assert_true(tcb_is_file(path));
+    free(old), free(neu), free(mix), free(md);
+    tu_remove_tree(dir);
 }
 
 static void test_empty_run_is_an_error(void **state)
@@ -567,7 +649,8 @@ int main(void)
         cmocka_unit_test(test_tex_uses_booktabs),
         cmocka_unit_test(test_pngs_are_valid),
     };
-    const struct CMUnitTest standalone[] = {cmocka_unit_test(test_empty_run_is_an_error)};
+    const struct CMUnitTest standalone[] = {cmocka_unit_test(test_empty_run_is_an_error),
+                                            cmocka_unit_test(test_old_cells_show_dash)};
     int failed = cmocka_run_group_tests(tests, setup, teardown);
     return failed + cmocka_run_group_tests(standalone, NULL, NULL);
 }

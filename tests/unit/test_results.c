@@ -51,8 +51,13 @@ static void make_cell(tcb_cell_result *c, const char *dataset, const char *seque
         }
         for (int s = 0; s < TCB_PCK_STEPS; s++) m.pck[s] = s / 99.0;
         m.auc = 0.5 + 0.1 * p;
+        for (int k = 0; k < 4; k++) tcb_stat_push(&m.geo, 0.03 * (p + 1) + 0.007 * k);
+        for (int s = 0; s < TCB_GEO_PCK_STEPS; s++) m.geo_pck[s] = s / 123.0;
+        m.geo_auc = 0.4 + 0.1 / 3 * p;
+        m.geo_unreachable = p;
         double cd = with_cd ? 1e-4 * (p + 1) / 3.0 : NAN;
-        pairs[p] = (tcb_pair_record){p, (p + 2) % 5, m.sl2, m.sl2sq, m.rank, m.auc, cd};
+        pairs[p] = (tcb_pair_record){p,   (p + 2) % 5, m.sl2, m.sl2sq,   m.rank,
+                                     m.auc, cd,        m.geo, m.geo_auc, m.geo_unreachable};
         tcb_summary_add_pair(&c->summary, &m, cd);
     }
 }
@@ -90,6 +95,9 @@ static void assert_cells_equal(const tcb_cell_result *a, const tcb_cell_result *
         assert_stat_equal(&x->rank, &y->rank);
         assert_true(x->auc == y->auc);
         assert_true(isnan(x->cd) ? isnan(y->cd) : x->cd == y->cd);
+        assert_stat_equal(&x->geo, &y->geo);
+        assert_true(x->geo.n == 0 || x->geo_auc == y->geo_auc);
+        assert_int_equal(x->geo_unreachable, y->geo_unreachable);
     }
     const tcb_summary *s = &a->summary, *t = &b->summary;
     assert_int_equal(s->n_pairs, t->n_pairs);
@@ -99,6 +107,10 @@ static void assert_cells_equal(const tcb_cell_result *a, const tcb_cell_result *
     assert_stat_equal(&s->auc, &t->auc);
     assert_stat_equal(&s->cd, &t->cd);
     assert_memory_equal(s->pck, t->pck, sizeof s->pck);
+    assert_stat_equal(&s->geo, &t->geo);
+    assert_stat_equal(&s->geo_auc, &t->geo_auc);
+    assert_memory_equal(s->geo_pck, t->geo_pck, sizeof s->geo_pck);
+    assert_true(s->geo_unreachable == t->geo_unreachable);
 }
 
 static void round_trip(int with_cd)
@@ -329,6 +341,100 @@ static void test_rejects_inconsistent_shapes(void **state)
     expect_rejected(extra_key, "colour");
 }
 
+/* The geodesic keys go together, and so do a pair's geodesic columns. */
+static void drop_geo_pck(cJSON *r)
+{
+    cJSON_DeleteItemFromObject(cJSON_GetObjectItem(r, "summary"), "geo_pck");
+}
+static void half_null_geo(cJSON *r)
+{
+    cJSON *row = cJSON_GetArrayItem(cJSON_GetObjectItem(r, "pairs"), 1);
+    cJSON_ReplaceItemInArray(row, 11, cJSON_CreateNull());
+}
+static void too_many_unreachable(cJSON *r)
+{
+    cJSON *row = cJSON_GetArrayItem(cJSON_GetObjectItem(r, "pairs"), 0);
+    cJSON_ReplaceItemInArray(row, 14, cJSON_CreateNumber(5)); /* n is 4 */
+}
+static void thirteen_columns(cJSON *r)
+{
+    cJSON *cols = cJSON_GetObjectItem(r, "pair_columns");
+    cJSON_DeleteItemFromArray(cols, 14);
+    cJSON_DeleteItemFromArray(cols, 13);
+}
+
+static void test_rejects_partial_geodesic(void **state)
+{
+    (void)state;
+    expect_rejected(drop_geo_pck, "summary.geo_pck");
+    expect_rejected(half_null_geo, "pairs[1]");
+    expect_rejected(too_many_unreachable, "pairs[0]");
+    expect_rejected(thirteen_columns, "pair_columns");
+}
+
+/* What a cell file written before the geodesic error looks like: no
+ * summary geodesic keys, the first 11 pair columns. */
+static void to_old_format(cJSON *root)
+{
+    cJSON *summary = cJSON_GetObjectItem(root, "summary");
+    static const char *const geo_keys[] = {"geo", "geo_auc", "geo_pck", "geo_unreachable"};
+    for (int k = 0; k < 4; k++) cJSON_DeleteItemFromObject(summary, geo_keys[k]);
+    cJSON *cols = cJSON_GetObjectItem(root, "pair_columns"), *row;
+    while (cJSON_GetArraySize(cols) > 11) cJSON_DeleteItemFromArray(cols, 11);
+    cJSON_ArrayForEach(row, cJSON_GetObjectItem(root, "pairs"))
+        while (cJSON_GetArraySize(row) > 11) cJSON_DeleteItemFromArray(row, 11);
+}
+
+/* The cell file at path through cJSON, edited by `edit` (NULL: none). */
+static void rewrite(const char *path, json_edit edit)
+{
+    cJSON *root;
+    tcb_error err = {0};
+    assert_int_equal(tcb_json_load(path, &root, &err), TCB_OK);
+    if (edit) edit(root);
+    assert_int_equal(tcb_json_save(path, root, &err), TCB_OK);
+    cJSON_Delete(root);
+}
+
+/* An older cell loads with no geodesic values and everything else as
+ * written; saved again (with null geodesic columns) it loads the same.
+ * (cJSON prints 15 significant digits where they nearly round-trip, so the
+ * reference is the file after one pass through cJSON, which a second pass
+ * leaves as it is.) */
+static void test_loads_cell_without_geodesic(void **state)
+{
+    (void)state;
+    char dir[512], path[4096];
+    tu_make_tmpdir(dir, sizeof dir);
+    tcb_pair_record pairs[3];
+    tcb_cell_result c, ref, old, again;
+    tcb_error err = {0};
+    make_cell(&c, "anim", "cat", "AN", 0, 1, pairs);
+    assert_int_equal(tcb_cell_path(path, sizeof path, dir, "anim", "cat", "AN", 0, &err), 0);
+    assert_int_equal(tcb_cell_save(path, &c, &err), TCB_OK);
+    rewrite(path, NULL);
+    assert_int_equal(tcb_cell_load(path, &ref, &err), TCB_OK);
+    rewrite(path, to_old_format);
+    assert_int_equal(tcb_cell_load(path, &old, &err), TCB_OK);
+    assert_true(old.summary.geo.n == 0 && old.summary.geo_auc.n == 0);
+    /* the Euclidean numbers untouched: the reference with its geodesic ones set aside */
+    for (int p = 0; p < 3; p++) {
+        assert_true(old.pairs[p].geo.n == 0);
+        ref.pairs[p].geo = (tcb_stat){0}, ref.pairs[p].geo_unreachable = 0;
+    }
+    ref.summary.geo = ref.summary.geo_auc = (tcb_stat){0};
+    memset(ref.summary.geo_pck, 0, sizeof ref.summary.geo_pck);
+    ref.summary.geo_unreachable = 0;
+    assert_cells_equal(&ref, &old);
+    assert_int_equal(tcb_cell_save(path, &old, &err), TCB_OK);
+    assert_int_equal(tcb_cell_load(path, &again, &err), TCB_OK);
+    assert_cells_equal(&old, &again);
+    tcb_cell_free(&ref);
+    tcb_cell_free(&old);
+    tcb_cell_free(&again);
+    tu_remove_tree(dir);
+}
+
 static void test_rejects_bad_json(void **state)
 {
     (void)state;
@@ -421,6 +527,8 @@ int main(void)
         cmocka_unit_test(test_rejects_wrong_type),
         cmocka_unit_test(test_rejects_wrong_format),
         cmocka_unit_test(test_rejects_inconsistent_shapes),
+        cmocka_unit_test(test_rejects_partial_geodesic),
+        cmocka_unit_test(test_loads_cell_without_geodesic),
         cmocka_unit_test(test_rejects_bad_json),
         cmocka_unit_test(test_scan_sorts_and_skips_non_cells),
         cmocka_unit_test(test_scan_rejects_misplaced_and_missing),
