@@ -1,22 +1,29 @@
 #!/usr/bin/env bash
-# The default benchmark (configs/quick.json) reproduces the committed
-# regression baseline: `tcbench check` exits 0, and oracle is perfect. The
-# cc rows (a 300-iteration training, far from converged) carry their own,
-# wide tolerances in the baseline: a build repeats them bit for bit at a
-# given thread count, but another build or CPU rounds a few operations
-# differently (vectorized reductions, BLAS kernels) and the training
-# amplifies it (the sanitized build's m_sL2 is 8-36 % off the Release
-# build's), so for cc this is a smoke check that training and read-out
-# work, not a regression check of its numbers.
+# The default benchmark (configs/quick.json: every method family on the
+# three embedded sequences) reproduces the committed regression baseline:
+# `tcbench check` exits 0, oracle is perfect, every cell is ok and the
+# methods that reconstruct have a Chamfer distance.
+#
+# It runs the Release binary (TCBENCH_RELEASE, which scripts/test.sh builds
+# and sets; skipped without it): the 24 cells would take most of the
+# suite's time under the sanitizers, and every method runs sanitized in its
+# own tests. The trained rows (the atlas methods' 300 iterations, cc's 300)
+# repeat bit for bit at a given thread count, but another thread count or
+# CPU rounds reductions differently and the training amplifies it, so their
+# rows in the baseline carry wider tolerances than the untrained methods'.
 set -euo pipefail
 : "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
+if [ -z "${TCBENCH_RELEASE:-}" ]; then
+    echo "skipped: set TCBENCH_RELEASE to a Release build's tcbench (scripts/test.sh does)"
+    exit 77
+fi
 
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cd "$TCB_SOURCE_DIR"   # the committed splits/ are reused, never rewritten
 
-"$TCBENCH" run configs/quick.json --out "$tmp/run" --quiet
-"$TCBENCH" check "$tmp/run" tests/baselines/quick.json > "$tmp/check.txt" || { cat "$tmp/check.txt"; exit 1; }
+"$TCBENCH_RELEASE" run configs/quick.json --out "$tmp/run" --quiet
+"$TCBENCH_RELEASE" check "$tmp/run" tests/baselines/quick.json > "$tmp/check.txt" || { cat "$tmp/check.txt"; exit 1; }
 cat "$tmp/check.txt"
 # The baseline carries the geodesic error too: nothing left unchecked.
 if grep -q unchecked "$tmp/check.txt"; then echo "FAIL: geodesic values missing from the baseline"; exit 1; fi
@@ -24,7 +31,9 @@ if grep -q unchecked "$tmp/check.txt"; then echo "FAIL: geodesic values missing 
 /usr/bin/python3 - "$tmp/run" <<'PY'
 import glob, json, sys
 cells = [json.load(open(p)) for p in glob.glob(sys.argv[1] + "/cells/**/*.json", recursive=True)]
-assert len(cells) == 9, len(cells)
+methods = {c["method"] for c in cells}
+assert len(cells) == 24 and len(methods) == 8, (len(cells), sorted(methods))
+reconstructs = {"atlasnet", "dsr", "mca"}
 for c in cells:
     s = c["summary"]
     assert c["status"] == "ok", c["message"]
@@ -36,10 +45,9 @@ for c in cells:
     if c["method"] == "oracle":
         assert s["sl2"]["mean"] == 0 and s["rank"]["mean"] == 0 and s["auc"]["mean"] == 1, s
         assert s["geo"]["mean"] == 0 and s["geo_auc"]["mean"] == 1, s
-    elif c["method"] == "cc":
-        assert c["timings"]["fit_s"] > 0 and s["cd"] is None, c
     else:
         assert s["sl2"]["mean"] > 0 and s["auc"]["mean"] < 1, s
         assert s["geo"]["mean"] > 0 and s["geo_auc"]["mean"] < 1, s
+    assert (s["cd"] is not None) == (c["method"] in reconstructs), c["method"]
 print("quick config: %d cells ok" % len(cells))
 PY
