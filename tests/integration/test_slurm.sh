@@ -11,65 +11,15 @@ set -euo pipefail
 : "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
 source "$TCB_SOURCE_DIR/tests/integration/cells.sh"
 skip() { echo "SKIP: $*"; exit 77; }
-[ "$(id -u)" -eq 0 ] || skip "needs root to start slurmd and munged"
-for b in munged slurmctld slurmd sbatch scontrol squeue sinfo runuser; do
-    command -v "$b" > /dev/null || skip "$b not found (scripts/setup.sh --tests installs slurm-wlm and munge)"
-done
-[ -r /etc/munge/munge.key ] || skip "no /etc/munge/munge.key (the munge package makes it)"
+source "$TCB_SOURCE_DIR/scripts/slurm/local-cluster.sh"
+if why=$(slurm_local_missing); then skip "$why"; fi
 
 tmp=$(mktemp -d)
 chmod 755 "$tmp"
-stop_daemons() {
-    for f in "$tmp/slurmd.pid" "$tmp/slurmctld.pid" "$tmp/munge/pid"; do
-        [ -s "$f" ] && kill "$(cat "$f")" 2> /dev/null || true
-    done
-    sleep 1
-    for f in "$tmp/slurmd.pid" "$tmp/slurmctld.pid" "$tmp/munge/pid"; do
-        [ -s "$f" ] && kill -9 "$(cat "$f")" 2> /dev/null || true
-    done
-}
-trap 'stop_daemons; rm -rf "$tmp"' EXIT
+trap 'slurm_local_stop "$tmp"; rm -rf "$tmp"' EXIT
 cd "$tmp"
-
-mkdir -p munge state spool
-chown munge:munge munge && chmod 755 munge
-runuser -u munge -- munged --socket="$tmp/munge/sock" --pid-file="$tmp/munge/pid" --log-file="$tmp/munge/log" \
-    --seed-file="$tmp/munge/seed" || skip "munged did not start: $(cat munge/log 2> /dev/null)"
-host=$(hostname -s)
-port=$((20000 + RANDOM % 20000))
-cat > slurm.conf <<CONF
-ClusterName=tcbtest
-SlurmctldHost=$host
-SlurmUser=root
-SlurmdUser=root
-SlurmctldPort=$port
-SlurmdPort=$((port + 1))
-AuthType=auth/munge
-AuthInfo=socket=$tmp/munge/sock
-CredType=cred/munge
-StateSaveLocation=$tmp/state
-SlurmdSpoolDir=$tmp/spool
-SlurmctldPidFile=$tmp/slurmctld.pid
-SlurmdPidFile=$tmp/slurmd.pid
-SlurmctldLogFile=$tmp/slurmctld.log
-SlurmdLogFile=$tmp/slurmd.log
-ProctrackType=proctrack/linuxproc
-TaskPlugin=task/none
-SelectType=select/cons_tres
-SelectTypeParameters=CR_CPU
-JobAcctGatherType=jobacct_gather/none
-AccountingStorageType=accounting_storage/none
-MpiDefault=none
-ReturnToService=2
-SchedulerParameters=sched_interval=2
-NodeName=$host CPUs=2 State=UNKNOWN
-PartitionName=test Nodes=ALL Default=YES MaxTime=INFINITE State=UP
-CONF
+why=$(slurm_local_start "$tmp" 2) || skip "$why"
 export SLURM_CONF="$tmp/slurm.conf"
-slurmctld -f "$SLURM_CONF" || skip "slurmctld did not start: $(tail -3 slurmctld.log 2> /dev/null)"
-slurmd -f "$SLURM_CONF" || skip "slurmd did not start: $(tail -3 slurmd.log 2> /dev/null)"
-for _ in $(seq 100); do sinfo -h -o %t 2> /dev/null | grep -q idle && break; sleep 0.2; done
-sinfo -h -o %t | grep -q idle || skip "the node did not come up: $(tail -3 slurmd.log)"
 
 # A grid of four cells, submitted as an array of one-CPU tasks.
 cat > grid.json <<'JSON'
