@@ -19,6 +19,7 @@ packages=(
 if [ "${1:-}" = "--tests" ]; then
   packages+=(python3-torch)               # the atlas network and training step against PyTorch
   packages+=(slurm-wlm munge)             # the one-node Slurm cluster of tests/integration/test_slurm.sh
+  packages+=(clang libclang-rt-dev libomp-dev) # the fuzz targets (fuzz/): clang's libFuzzer and sanitizers, its OpenMP
 elif [ $# -gt 0 ]; then
   echo "usage: scripts/setup.sh [--tests]" >&2; exit 2
 fi

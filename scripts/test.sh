@@ -15,7 +15,12 @@ cmake --build build-test -j"$(nproc)" >/dev/null
 # sanitized in its own tests.
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DTCB_BUILD_TESTS=OFF >/dev/null
 cmake --build build -j"$(nproc)" >/dev/null
+# The fuzz targets (fuzz/README.md), built by clang with libFuzzer: each
+# searches for TCB_FUZZ_SMOKE_S (20) seconds from its seeds, after the
+# suite. (The sanitized build above replays their seeds and regressions.)
+CC=clang cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTCB_FUZZ=ON -DTCB_BUILD_TESTS=OFF >/dev/null
+cmake --build build-fuzz -j"$(nproc)" --target fuzz_targets >/dev/null
 export TCBENCH_RELEASE="$PWD/build/tcbench"
-cd build-test
-ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-  ctest --output-on-failure -j"$(nproc)" "$@"
+export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1
+(cd build-test && ctest --output-on-failure -j"$(nproc)" "$@")
+(cd build-fuzz && ctest --output-on-failure -j"$(nproc)" "$@")

@@ -1,0 +1,71 @@
+#include "fuzz/fuzz_util.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tcb/fsutil.h"
+
+/* libFuzzer calls the target with no context to carry state in, so the
+ * scratch directory is the one process-wide variable: created on first
+ * use, removed by atexit. */
+static char scratch[TCB_PATH_MAX];
+
+static void remove_scratch(void)
+{
+    tcb_error err = {0};
+    if (tcb_empty_dir(scratch, &err) == TCB_OK) remove(scratch);
+}
+
+const char *fuzz_dir(void)
+{
+    if (scratch[0]) return scratch;
+    const char *tmp = getenv("TMPDIR");
+    tcb_error err = {0};
+    if (tcb_path_join(scratch, sizeof scratch, &err, "%s/tcbench-fuzz-XXXXXX", tmp && tmp[0] ? tmp : "/tmp")) {
+        fprintf(stderr, "%s\n", err.msg);
+        abort();
+    }
+    if (!mkdtemp(scratch)) {
+        perror(scratch);
+        abort();
+    }
+    atexit(remove_scratch);
+    return scratch;
+}
+
+const char *fuzz_file(const char *name, const uint8_t *data, size_t size)
+{
+    static char path[TCB_PATH_MAX];
+    tcb_error err = {0};
+    if (tcb_path_join(path, sizeof path, &err, "%s/%s", fuzz_dir(), name)) {
+        fprintf(stderr, "%s\n", err.msg);
+        abort();
+    }
+    FILE *fp = fopen(path, "wb");
+    if (!fp || fwrite(data, 1, size, fp) != size || fclose(fp)) {
+        perror(path);
+        abort();
+    }
+    return path;
+}
+
+void fuzz_require(int cond, const char *what)
+{
+    if (cond) return;
+    fprintf(stderr, "fuzz invariant broken: %s\n", what);
+    abort();
+}
+
+void fuzz_check_answer(int rc, const tcb_error *err, const char *path)
+{
+    if (getenv("TCB_FUZZ_VERBOSE")) fprintf(stderr, "answer: %s\n", rc ? err->msg : "accepted");
+    if (rc == TCB_OK) return;
+    fuzz_require(err->code == (tcb_status)rc, "the error's code is the status returned");
+    fuzz_require(err->msg[0] != '\0', "a failure comes with a message");
+    fuzz_require(strchr(err->msg, '\n') == NULL, "the message is one line");
+    if (path && !strstr(err->msg, path)) {
+        fprintf(stderr, "message without the file's name %s: %s\n", path, err->msg);
+        abort();
+    }
+}

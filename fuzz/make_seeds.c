@@ -1,0 +1,155 @@
+/* Writes the seed corpora the build generates (the committed ones are
+ * small text files under fuzz/seeds/): files the checkpoint targets'
+ * objects accept, and HDF5 programs (h5_program.h) that build valid files.
+ *   make_seeds OUT_DIR   → OUT_DIR/<target>/<seed>
+ * Deterministic: the same build writes the same bytes. */
+#include <hdf5.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fuzz/h5_names.h"
+#include "fuzz/h5_program.h"
+#include "fuzz/tiny.h"
+#include "methods/atlas/train_ckpt.h"
+#include "tcb/fsutil.h"
+#include "tcb/registry.h"
+
+static void ok(int rc, const tcb_error *err)
+{
+    if (rc == TCB_OK) return;
+    fprintf(stderr, "make_seeds: %s\n", err->msg);
+    exit(1);
+}
+
+static void path_of(char *out, const char *dir, const char *target, const char *name)
+{
+    tcb_error err = {0};
+    ok(tcb_path_join(out, TCB_PATH_MAX, &err, "%s/%s/%s", dir, target, name), &err);
+}
+
+static void train_ckpt(const char *dir, const tcb_sequence *seq)
+{
+    tcb_atlas_model *model;
+    tcb_atlas_trainer *t;
+    fuzz_tiny_trainer(seq, &model, &t);
+    char path[TCB_PATH_MAX];
+    tcb_error err = {0};
+    double loss;
+    for (int it = 0; it < 2; it++) ok(tcb_atlas_train_step(t, seq, &loss, &err), &err);
+    path_of(path, dir, "train_ckpt", "step2.ckpt");
+    ok(tcb_atlas_train_ckpt_save(t, seq, FUZZ_TINY_SEED, 1.5, path, &err), &err);
+    tcb_atlas_trainer_free(t);
+    tcb_atlas_model_free(model);
+}
+
+/* The method fitted on seq and saved: what its load reads. */
+static void fitted_model(const char *dir, const char *method, const tcb_sequence *seq)
+{
+    const tcb_method_ops *ops = tcb_registry_find(method);
+    void *self = fuzz_tiny_method(method);
+    char work[TCB_PATH_MAX], path[TCB_PATH_MAX];
+    path_of(work, dir, "work", method);
+    tcb_error err = {0};
+    ok(tcb_mkdirs(work, &err), &err);
+    tcb_fit_ctx ctx = {.seed = FUZZ_TINY_SEED, .n_threads = 1, .work_dir = work};
+    ok(ops->fit(self, seq, &ctx, &err), &err);
+    path_of(path, dir, method, "");
+    ok(tcb_mkdirs(path, &err), &err);
+    path_of(path, dir, method, "fitted.bin");
+    ok(ops->save(self, path, &err), &err);
+    ops->destroy(self);
+}
+
+static void write_program(const char *dir, const char *target, const char *name, const h5prog_buf *b)
+{
+    char path[TCB_PATH_MAX];
+    path_of(path, dir, target, name);
+    tcb_error err = {0};
+    ok(tcb_write_file_atomic(path, b->bytes, b->len, &err), &err);
+}
+
+/* The format version the cache writes today, read from one it wrote. */
+static int32_t cache_version(const char *dir, const tcb_sequence *seq)
+{
+    char path[TCB_PATH_MAX];
+    path_of(path, dir, "work", "version.h5");
+    tcb_error err = {0};
+    ok(tcb_sequence_cache_save(path, seq, CACHE_KEY_TEXT, &err), &err);
+    int32_t version = -1;
+    hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    hid_t a = file < 0 ? -1 : H5Aopen(file, "format_version", H5P_DEFAULT);
+    if (a < 0 || H5Aread(a, H5T_NATIVE_INT32, &version) < 0) {
+        fprintf(stderr, "make_seeds: no format_version in %s\n", path);
+        exit(1);
+    }
+    H5Aclose(a), H5Fclose(file), remove(path);
+    return version;
+}
+
+/* A tetrahedron over 3 frames, as the cache writes it. */
+static void cache_program(const char *dir, const tcb_sequence *seq)
+{
+    static const float verts[3][4][3] = {{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+                                         {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 2}},
+                                         {{0, 0, 0}, {2, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+    static const int32_t faces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+    static const double areas[3] = {2.4, 3.1, 3.1}, shift[3][3] = {{0}}, scale = 1;
+    static const int32_t norm = 0;
+    const int32_t version = cache_version(dir, seq);
+    h5prog_buf b = {0};
+    h5prog_add_array(&b, 0, CACHE_VERTS, H5P_F32, 3, (const int[]){3, 4, 3}, verts);
+    h5prog_add_array(&b, 0, CACHE_FACES, H5P_I32, 2, (const int[]){4, 3}, faces);
+    h5prog_add_array(&b, 0, CACHE_AREAS, H5P_F64, 1, (const int[]){3}, areas);
+    h5prog_add_array(&b, 0, CACHE_NORM_SHIFT, H5P_F64, 2, (const int[]){3, 3}, shift);
+    h5prog_add_array(&b, 1, CACHE_FORMAT_VERSION, H5P_I32, 0, NULL, &version);
+    h5prog_add_string(&b, 1, CACHE_KEY, CACHE_KEY_TEXT);
+    h5prog_add_string(&b, 1, CACHE_NAME, "tet");
+    h5prog_add_array(&b, 1, CACHE_NORM, H5P_I32, 0, NULL, &norm);
+    h5prog_add_array(&b, 1, CACHE_NORM_SCALE, H5P_F64, 0, NULL, &scale);
+    write_program(dir, "cache", "tetrahedron.prog", &b);
+    h5prog_add_array(&b, 0, CACHE_POOLS, H5P_F32, 3, (const int[]){3, 4, 3}, verts);
+    h5prog_add_array(&b, 0, CACHE_YAW, H5P_F64, 1, (const int[]){3}, areas);
+    write_program(dir, "cache", "tetrahedron_pools_yaw.prog", &b);
+    free(b.bytes);
+}
+
+/* Two subjects of a tetrahedron, (V, 3, F) = (4, 3, 2). */
+static void dfaust_program(const char *dir)
+{
+    static const float regs[4][3][2] = {{{0, 0}, {0, 0}, {0, 0}}, {{1, 1}, {0, 0}, {0, 0}},
+                                        {{0, 0}, {1, 1}, {0, 0}}, {{0, 0}, {0, 0}, {1, 2}}};
+    static const int32_t faces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+    h5prog_buf b = {0};
+    h5prog_add_array(&b, 0, DFAUST_FACES, H5P_I32, 2, (const int[]){4, 3}, faces);
+    h5prog_add_array(&b, 0, DFAUST_50002, H5P_F32, 3, (const int[]){4, 3, 2}, regs);
+    write_program(dir, "dfaust", "one_subject.prog", &b);
+    h5prog_add_array(&b, 0, DFAUST_50004, H5P_F32, 3, (const int[]){4, 3, 2}, regs);
+    write_program(dir, "dfaust", "two_subjects.prog", &b);
+    free(b.bytes);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 2) {
+        fprintf(stderr, "usage: make_seeds OUT_DIR\n");
+        return 2;
+    }
+    /* dir/work: the fits' work directories and a scratch cache, removed at the end */
+    char work[TCB_PATH_MAX];
+    path_of(work, argv[1], "work", "");
+    tcb_error err = {0};
+    ok(tcb_mkdirs(work, &err), &err);
+    tcb_sequence seq;
+    fuzz_tiny_sequence(&seq);
+    train_ckpt(argv[1], &seq);
+    fitted_model(argv[1], "mca", &seq);
+    fitted_model(argv[1], "cc", &seq);
+    fitted_model(argv[1], "nricp", &seq);
+    cache_program(argv[1], &seq);
+    tcb_sequence_free(&seq);
+    dfaust_program(argv[1]);
+    ok(tcb_empty_dir(work, &err), &err);
+    remove(work);
+    return 0;
+}

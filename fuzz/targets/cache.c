@@ -1,0 +1,44 @@
+/* The HDF5 sequence cache (datasets/cache.c), structure-aware (see
+ * fuzz/h5_program.h): a cache loaded has faces within its vertices and
+ * finite coordinates, areas and pools. */
+#include <math.h>
+
+#include "fuzz/fuzz_util.h"
+#include "fuzz/h5_names.h"
+#include "fuzz/h5_program.h"
+#include "tcb/sequence.h"
+
+static int all_finite_f(const float *x, size_t n)
+{
+    for (size_t k = 0; k < n; k++)
+        if (!isfinite(x[k])) return 0;
+    return 1;
+}
+
+static int all_finite_d(const double *x, size_t n)
+{
+    for (size_t k = 0; k < n; k++)
+        if (!isfinite(x[k])) return 0;
+    return 1;
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    const char *path = fuzz_file("cache.h5", (const uint8_t *)"", 0);
+    h5prog_build(data, size, cache_names, CACHE_N_NAMES, path);
+    tcb_sequence s;
+    tcb_error err = {0};
+    int rc = tcb_sequence_cache_load(path, CACHE_KEY_TEXT, &s, &err);
+    fuzz_check_answer(rc, &err, path);
+    if (rc) return 0;
+    size_t F = (size_t)s.n_frames, V = (size_t)s.n_verts;
+    for (size_t k = 0; k < 3 * (size_t)s.n_faces; k++)
+        fuzz_require(s.faces[k] >= 0 && s.faces[k] < s.n_verts, "faces within the vertices");
+    fuzz_require(all_finite_f(s.verts, F * V * 3), "finite vertices");
+    fuzz_require(all_finite_d(s.areas, F) && all_finite_d(s.norm_shift, 3 * F) && isfinite(s.norm_scale),
+                 "finite areas and normalization");
+    fuzz_require(!s.pools || all_finite_f(s.pools, F * (size_t)s.pool_size * 3), "finite pools");
+    fuzz_require(!s.yaw || all_finite_d(s.yaw, F), "finite yaw");
+    tcb_sequence_free(&s);
+    return 0;
+}
