@@ -46,17 +46,25 @@ lock=long/cells/synth/quadruped_walk/mca/seed_0.json.lock
 for _ in $(seq 600); do [ -e "$lock" ] && break; sleep 0.1; done
 sleep 1 # into the training
 scancel --batch --signal=USR1 "${job}_1" || { echo "FAIL: could not signal the task"; cat long-1.log; exit 1; }
-# Slurm holds a requeued job back for a while (BeginTime); let it start now.
+# Slurm holds a requeued job back (BeginTime: until the old job's
+# credential has expired, 120 s); let it start sooner, but only 2 s after
+# the requeue: slurmd refuses a credential created within the second its
+# predecessor was revoked in (and the job then fails and leaves the queue).
 for _ in $(seq 600); do
     scontrol show job "${job}_1" 2> /dev/null | grep -q "Reason=BeginTime" && break
     sleep 0.1
 done
+sleep 2
 scontrol update JobId="${job}_1" StartTime=now
 for _ in $(seq 1200); do
     [ -s long/cells/synth/quadruped_walk/mca/seed_0.json ] && [ -z "$(squeue -h -j "$job" 2> /dev/null)" ] && break
     sleep 0.2
 done
-[ -s long/cells/synth/quadruped_walk/mca/seed_0.json ] || { echo "FAIL: the requeued task did not finish"; cat long-*.log; squeue; exit 1; }
+[ -s long/cells/synth/quadruped_walk/mca/seed_0.json ] || {
+    echo "FAIL: the requeued task did not finish"
+    cat long-*.log; squeue; scontrol show job "${job}_1"; tail -20 slurmctld.log slurmd.log
+    exit 1
+}
 # Where the stop lands depends on the machine's speed: mid-training mostly.
 grep -qE "stopped (at iteration [0-9]+ of 800; training state saved|at pair|before cell)" long-1.log &&
     grep -qF "stopped with its state saved; requeueing ${job}_1" long-1.log || { echo "FAIL: no requeue"; cat long-1.log; exit 1; }
