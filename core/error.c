@@ -4,6 +4,29 @@
 #include <stdio.h>
 #include <string.h>
 
+/* A message is one line of text: it is printed to terminals and logs and
+ * stored in cell files, and it quotes what the user's file held (a JSON
+ * key, a name), which may hold a newline or an escape sequence. ASCII
+ * control characters are written as C escapes; the rest, UTF-8 included,
+ * is kept. The result is truncated to the message's size. */
+static void escape_controls(char *msg)
+{
+    char out[TCB_ERRMSG_MAX];
+    size_t n = 0;
+    for (const unsigned char *p = (const unsigned char *)msg; *p; p++) {
+        char e[5] = {(char)*p, '\0'};
+        if (*p == '\n' || *p == '\t' || *p == '\r')
+            snprintf(e, sizeof e, "\\%c", *p == '\n' ? 'n' : *p == '\t' ? 't' : 'r');
+        else if (*p < 0x20 || *p == 0x7f) snprintf(e, sizeof e, "\\x%02x", *p);
+        size_t len = strlen(e);
+        if (n + len >= sizeof out) break;
+        memcpy(out + n, e, len);
+        n += len;
+    }
+    out[n] = '\0';
+    memcpy(msg, out, n + 1);
+}
+
 int tcb_fail(tcb_error *err, tcb_status code, const char *fmt, ...)
 {
     if (err) {
@@ -11,6 +34,7 @@ int tcb_fail(tcb_error *err, tcb_status code, const char *fmt, ...)
         va_start(ap, fmt);
         vsnprintf(err->msg, sizeof err->msg, fmt, ap);
         va_end(ap);
+        escape_controls(err->msg);
         err->code = code;
     }
     return (int)code;
@@ -31,6 +55,7 @@ void tcb_error_prefix(tcb_error *err, const char *fmt, ...)
     memcpy(err->msg, prefix, lp);
     memcpy(err->msg + lp, old, lo);
     err->msg[lp + lo] = '\0';
+    escape_controls(err->msg);
 }
 
 void tcb_error_clear(tcb_error *err)

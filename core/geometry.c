@@ -15,6 +15,20 @@ static void tri_cross(const float *a, const float *b, const float *c, double n[3
     n[2] = u[0] * v[1] - u[1] * v[0];
 }
 
+int tcb_all_finite(const float *x, size_t n)
+{
+    for (size_t k = 0; k < n; k++)
+        if (!isfinite(x[k])) return 0;
+    return 1;
+}
+
+int tcb_all_finite_d(const double *x, size_t n)
+{
+    for (size_t k = 0; k < n; k++)
+        if (!isfinite(x[k])) return 0;
+    return 1;
+}
+
 double tcb_triangle_area(const float *a, const float *b, const float *c)
 {
     double n[3];

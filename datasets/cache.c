@@ -12,6 +12,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <hdf5.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,6 +22,7 @@
 #include "datasets/h5util.h"
 #include "datasets/strbuf.h"
 #include "tcb/fsutil.h"
+#include "tcb/geometry.h"
 #include "tcb/sequence.h"
 
 /* Bump when the layout or the meaning of any field changes (4: /blocks). */
@@ -260,6 +262,17 @@ static int read_blocks(hid_t file, const char *path, tcb_sequence *out, tcb_erro
     return TCB_OK;
 }
 
+/* What was written was finite (the writer's sequence passed the loaders'
+ * checks): a NaN here is a damaged file, and would poison every metric. */
+static int all_finite(const tcb_sequence *s)
+{
+    size_t F = (size_t)s->n_frames;
+    return tcb_all_finite(s->verts, F * (size_t)s->n_verts * 3) && tcb_all_finite_d(s->areas, F) &&
+           tcb_all_finite_d(s->norm_shift, F * 3) && isfinite(s->norm_scale) &&
+           (!s->pools || tcb_all_finite(s->pools, F * (size_t)s->pool_size * 3)) &&
+           (!s->yaw || tcb_all_finite_d(s->yaw, F));
+}
+
 static int read_contents(hid_t file, const char *path, tcb_sequence *out, tcb_error *err)
 {
     int rc = alloc_from_shapes(file, path, out, err);
@@ -278,6 +291,7 @@ static int read_contents(hid_t file, const char *path, tcb_sequence *out, tcb_er
         (out->yaw && read_array(file, "yaw", H5T_NATIVE_DOUBLE, 1, &F, out->yaw) != 0))
         return corrupt(path, "unreadable attribute or array", err);
     if (norm < TCB_NORM_NONE || norm > TCB_NORM_PER_FRAME) return corrupt(path, "unknown normalization", err);
+    if (!all_finite(out)) return corrupt(path, "a coordinate, area or normalization that is not finite", err);
     out->norm = (tcb_normalization)norm;
     /* Bad ids would turn into out-of-bounds reads far from here. */
     for (size_t i = 0; i < 3 * (size_t)out->n_faces; i++)

@@ -26,7 +26,7 @@ one() {
     # run's limits in place of the smoke test's time.
     args=$(ctest -R "^fuzz_smoke_${t}\$" --show-only=json-v1 |
         /usr/bin/python3 -c 'import json,sys; print("\n".join(json.load(sys.stdin)["tests"][0]["command"][1:]))' |
-        grep -v '^-max_total_time=')
+        grep -v '^-max_total_time=\|^-artifact_prefix=')
     mapfile -t args <<< "$args"
     LSAN_OPTIONS="suppressions=$src/tests/lsan.supp" OMP_NUM_THREADS=1 OMP_WAIT_POLICY=passive \
         ./"fuzz_$t" -runs="$runs" -max_total_time="$seconds" -artifact_prefix="findings/$t-" "${args[@]}" \

@@ -12,6 +12,7 @@
 
 #include "harness/internal.h"
 #include "tcb/fsutil.h"
+#include "tcb/geometry.h"
 #include "tcb/metrics.h"
 
 /* Per-pair scratch, sized for the sequence once per cell, and the scorer
@@ -46,13 +47,6 @@ static int eval_bufs_init(const tcb_sequence *seq, eval_bufs *b, tcb_error *herr
     int rc = tcb_pair_scorer_init(&b->scorer, seq, herr);
     if (rc) eval_bufs_free(b);
     return rc;
-}
-
-int tcb_all_finite(const float *x, size_t n)
-{
-    for (size_t k = 0; k < n; k++)
-        if (!isfinite(x[k])) return 0;
-    return 1;
 }
 
 void tcb_cell_label(char *out, size_t size, const char *dataset, const char *sequence,

@@ -11,6 +11,7 @@
  * way, so two processes finding one stale lock cannot both take it. */
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <pthread.h>
 #include <signal.h>
 #include <stdio.h>
@@ -55,7 +56,9 @@ static int read_lock(const char *path, tcb_lock_info *info)
     const cJSON *host = cJSON_GetObjectItemCaseSensitive(j, "host");
     const cJSON *pid = cJSON_GetObjectItemCaseSensitive(j, "pid");
     const cJSON *started = cJSON_GetObjectItemCaseSensitive(j, "started");
-    int ok = cJSON_IsString(host) && cJSON_IsNumber(pid) && cJSON_IsNumber(started);
+    /* A pid outside pid_t's range is no pid (and casting it would be undefined). */
+    int ok = cJSON_IsString(host) && cJSON_IsNumber(pid) && pid->valuedouble >= 1 &&
+             pid->valuedouble <= INT_MAX && cJSON_IsNumber(started);
     if (ok) {
         snprintf(info->host, sizeof info->host, "%s", host->valuestring);
         info->pid = (long)pid->valuedouble, info->started = started->valuedouble;

@@ -8,6 +8,7 @@
 #include "harness/frames_style.h"
 #include "harness/render.h"
 #include "tcb/fsutil.h"
+#include "tcb/geometry.h"
 
 /* More charts would make the texture larger than viewers like (16 x 16
  * cells of 256 pixels: 4096 pixels a side). */

@@ -9,6 +9,7 @@
 #include "harness/frames_style.h"
 #include "harness/render.h"
 #include "tcb/fsutil.h"
+#include "tcb/geometry.h"
 #include "tcb/mesh.h"
 
 typedef struct transfers {

@@ -165,10 +165,6 @@ typedef struct tcb_cell_job {
 int tcb_fit_time_save(const char *checkpoint, double fit_s, tcb_error *err);
 int tcb_fit_time_load(const char *checkpoint, double *fit_s, tcb_error *err);
 
-/* Every x[k], k < n, is finite: what the harness checks of a method's
- * points before using them. (harness/cell.c) */
-int tcb_all_finite(const float *x, size_t n);
-
 /* A cell of a finished run picked by name, for `tcbench inspect` and
  * `tcbench frames` (harness/cell_target.c). */
 typedef struct tcb_cell_target {

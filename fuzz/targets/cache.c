@@ -6,21 +6,8 @@
 #include "fuzz/fuzz_util.h"
 #include "fuzz/h5_names.h"
 #include "fuzz/h5_program.h"
+#include "tcb/geometry.h"
 #include "tcb/sequence.h"
-
-static int all_finite_f(const float *x, size_t n)
-{
-    for (size_t k = 0; k < n; k++)
-        if (!isfinite(x[k])) return 0;
-    return 1;
-}
-
-static int all_finite_d(const double *x, size_t n)
-{
-    for (size_t k = 0; k < n; k++)
-        if (!isfinite(x[k])) return 0;
-    return 1;
-}
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
@@ -34,11 +21,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     size_t F = (size_t)s.n_frames, V = (size_t)s.n_verts;
     for (size_t k = 0; k < 3 * (size_t)s.n_faces; k++)
         fuzz_require(s.faces[k] >= 0 && s.faces[k] < s.n_verts, "faces within the vertices");
-    fuzz_require(all_finite_f(s.verts, F * V * 3), "finite vertices");
-    fuzz_require(all_finite_d(s.areas, F) && all_finite_d(s.norm_shift, 3 * F) && isfinite(s.norm_scale),
+    fuzz_require(tcb_all_finite(s.verts, F * V * 3), "finite vertices");
+    fuzz_require(tcb_all_finite_d(s.areas, F) && tcb_all_finite_d(s.norm_shift, 3 * F) && isfinite(s.norm_scale),
                  "finite areas and normalization");
-    fuzz_require(!s.pools || all_finite_f(s.pools, F * (size_t)s.pool_size * 3), "finite pools");
-    fuzz_require(!s.yaw || all_finite_d(s.yaw, F), "finite yaw");
+    fuzz_require(!s.pools || tcb_all_finite(s.pools, F * (size_t)s.pool_size * 3), "finite pools");
+    fuzz_require(!s.yaw || tcb_all_finite_d(s.yaw, F), "finite yaw");
     tcb_sequence_free(&s);
     return 0;
 }

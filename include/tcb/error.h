@@ -31,7 +31,9 @@ typedef struct tcb_error {
 
 /* Record an error and return its code, so callers can write
  *     return tcb_fail(err, TCB_ERR_INPUT, "%s:%d: bad vertex", path, line);
- * `err` may be NULL (the message is then dropped). */
+ * `err` may be NULL (the message is then dropped). The message is one
+ * line: control characters in it (from a quoted key or name) are written
+ * as C escapes (\n, \x1b). */
 int tcb_fail(tcb_error *err, tcb_status code, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 

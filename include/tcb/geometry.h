@@ -2,6 +2,7 @@
 #ifndef TCB_GEOMETRY_H
 #define TCB_GEOMETRY_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "tcb/error.h"
@@ -10,6 +11,11 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* Every x[k], k < n, is finite: what is checked of a method's points, a
+ * cache's arrays, before they are used. */
+int tcb_all_finite(const float *x, size_t n);
+int tcb_all_finite_d(const double *x, size_t n);
 
 double tcb_triangle_area(const float *a, const float *b, const float *c);
 

@@ -50,6 +50,18 @@ static void test_error_prefix_keeps_message(void **state)
     assert_int_equal(tcb_fail(NULL, TCB_ERR_IO, "dropped"), TCB_ERR_IO);
 }
 
+/* A message is one line whatever it quotes (found by the fuzz targets: a
+ * JSON key holding a newline came out verbatim), also after a prefix. */
+static void test_error_message_is_one_line(void **state)
+{
+    (void)state;
+    tcb_error err = {0};
+    tcb_fail(&err, TCB_ERR_INPUT, "f.json.%s: unknown key", "a\nb\tc\x1b[31m\x7f");
+    assert_string_equal(err.msg, "f.json.a\\nb\\tc\\x1b[31m\\x7f: unknown key");
+    tcb_error_prefix(&err, "run\r%s: ", "é");
+    assert_string_equal(err.msg, "run\\ré: f.json.a\\nb\\tc\\x1b[31m\\x7f: unknown key");
+}
+
 static void test_rng_is_reproducible_and_streams_differ(void **state)
 {
     (void)state;
@@ -265,6 +277,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_error_prefix_keeps_message),
+        cmocka_unit_test(test_error_message_is_one_line),
         cmocka_unit_test(test_rng_is_reproducible_and_streams_differ),
         cmocka_unit_test(test_rng_distributions),
         cmocka_unit_test(test_atomic_write_commit_and_abort),
