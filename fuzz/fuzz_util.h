@@ -20,7 +20,7 @@
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 /* Writes data[0..size) to `name` inside this process's scratch directory
- * (made on first use, removed at exit) and returns the file's path, valid
+ * (made on first use in $TMPDIR, else /dev/shm, else /tmp; removed at exit) and returns the file's path, valid
  * until the next call with the same name. Aborts when the disk refuses:
  * a target must never report a harness failure as a finding. */
 const char *fuzz_file(const char *name, const uint8_t *data, size_t size);
