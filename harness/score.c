@@ -126,7 +126,7 @@ static int score_cell(const tcb_config *cfg, const tcb_score_opts *o, const targ
     tcb_split split = {0};
     char split_path[TCB_PATH_MAX];
     double t0 = tcb_now_seconds();
-    int rc = tcb_harness_load_sequence(cfg, t->d, t->s->name, &seq, err);
+    int rc = tcb_harness_load_sequence(cfg, t->d, t->s->name, NULL, &seq, err);
     if (rc) return rc;
     double load_s = tcb_now_seconds() - t0;
     rc = tcb_harness_obtain_split(cfg, t->d, t->s, &seq, split_path, sizeof split_path, &split, err);
