@@ -13,13 +13,13 @@ source "$TCB_SOURCE_DIR/tests/integration/expect.sh"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cd "$tmp"
-"$TCBENCH" datasets synth --out data --sequence quadruped_walk --frames 5 2> /dev/null
+"$TCBENCH" datasets synth --out data --sequence quadruped_walk --frames 4 2> /dev/null
 cp -a data moved
 
 config() { # NAME THREADS PAIRS FRAMES [MORE KEYS]
     cat <<JSON
 { "name": "$1", "splits_dir": "splits_$3", "cache_dir": "", "seeds": [0, 1], "threads": $2,
-  "evaluation": { "pairs": $3, "pool_size": 300, "input_points": 100 },
+  "evaluation": { "pairs": $3, "pool_size": 200, "input_points": 100 },
   "datasets": [ { "name": "synth", "source": "synthetic", "frames": $4,
                   "sequences": [ { "name": "quadruped_trot", "role": "test" } ] },
                 { "name": "files", "source": "objdir", "root": "data",
@@ -27,17 +27,17 @@ config() { # NAME THREADS PAIRS FRAMES [MORE KEYS]
   "methods": [ { "name": "oracle" }, { "name": "nearest" } ]${5:-} }
 JSON
 }
-config a 1 10 6 > a.json
-config b 1 8 6 > b.json
-config c 1 10 7 > c.json
-config renamed 2 10 6 > renamed.json
-config v 1 10 6 ', "variants": { "one": { "seeds": [0] }, "two": { "seeds": [0, 1] } }' > v.json
+config a 1 3 4 > a.json
+config b 1 2 4 > b.json
+config c 1 3 5 > c.json
+config renamed 2 3 4 > renamed.json
+config v 1 3 4 ', "variants": { "one": { "seeds": [0] }, "two": { "seeds": [0, 1] } }' > v.json
 "$TCBENCH" run a.json --out run --quiet 2> /dev/null
 cp run/config.json a.saved
 
-expect 2 "run/config.json: the run directory holds the cells of another config than b.json (evaluation.pairs: 10 there, 8 here); cells of different settings are not mixed: give this config another --out, or --force" \
+expect 2 "run/config.json: the run directory holds the cells of another config than b.json (evaluation.pairs: 3 there, 2 here); cells of different settings are not mixed: give this config another --out, or --force" \
     "$TCBENCH" run b.json --out run --quiet
-expect 2 "(datasets[0].frames: 6 there, 7 here)" "$TCBENCH" run c.json --out run --cell 0 --quiet
+expect 2 "(datasets[0].frames: 4 there, 5 here)" "$TCBENCH" run c.json --out run --cell 0 --quiet
 cmp -s run/config.json a.saved || { echo "FAIL: a refused run changed config.json"; exit 1; }
 [ "$(find run -newer a.saved -type f | wc -l)" -eq 0 ] || { echo "FAIL: a refused run wrote"; find run -newer a.saved; exit 1; }
 
@@ -52,7 +52,7 @@ expect 2 "(seeds: [0] there, [0,1] here)" "$TCBENCH" run v.json --variant two --
 
 # --force hands the directory over; the other config is then refused.
 expect 0 "8 computed" "$TCBENCH" run b.json --out run --force --quiet
-expect 2 "than a.json (evaluation.pairs: 8 there, 10 here)" "$TCBENCH" run a.json --out run --quiet
+expect 2 "than a.json (evaluation.pairs: 2 there, 3 here)" "$TCBENCH" run a.json --out run --quiet
 
 # Two configs at once on a new directory: one claims it, the other is refused.
 rc_a=0 rc_b=0
