@@ -91,8 +91,8 @@ static int same_cells(const char *path, const tcb_config *cfg, tcb_error *err)
         if (first_difference(was, now, where, sizeof where, a, b, sizeof a))
             rc = tcb_fail(err, TCB_ERR_INPUT,
                           "%s: the run directory holds the cells of another config than %s (%s: %s there, %s "
-                          "here); cells of different settings are not mixed: give this config another --out, "
-                          "or --force to recompute its cells here and leave the directory to it",
+                          "here); cells of different settings are not mixed: give this config another --out "
+                          "(or 'tcbench run --force' to recompute its cells here and leave the directory to it)",
                           path, cfg->path, where[0] ? where : "the whole config", a, b);
     }
     cJSON_Delete(was);

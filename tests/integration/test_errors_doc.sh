@@ -252,6 +252,9 @@ row "a NaN point" score
 section "Run directory"
 conf other.json '{"evaluation": {"pairs": 1, "pool_size": 200, "input_points": 100}}'
 row "another config's cells" run other.json --out runs/split
+conf pool.json '{"evaluation": {"pairs": 2, "pool_size": 250, "input_points": 100}}'
+preds
+row "predictions scored into another config's" "$TCBENCH" score pool.json --dataset synth --sequence quadruped_walk --pred pred --name files --out runs/split
 touch afile
 row "a file where the directory should be" run split.json --out afile
 mkdir -p broken && echo '{"name": ' > broken/config.json

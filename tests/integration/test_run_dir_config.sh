@@ -35,7 +35,7 @@ config v 1 3 4 ', "variants": { "one": { "seeds": [0] }, "two": { "seeds": [0, 1
 "$TCBENCH" run a.json --out run --quiet 2> /dev/null
 cp run/config.json a.saved
 
-expect 2 "run/config.json: the run directory holds the cells of another config than b.json (evaluation.pairs: 3 there, 2 here); cells of different settings are not mixed: give this config another --out, or --force" \
+expect 2 "run/config.json: the run directory holds the cells of another config than b.json (evaluation.pairs: 3 there, 2 here); cells of different settings are not mixed: give this config another --out (or 'tcbench run --force' to recompute" \
     "$TCBENCH" run b.json --out run --quiet
 expect 2 "(datasets[0].frames: 4 there, 5 here)" "$TCBENCH" run c.json --out run --cell 0 --quiet
 cmp -s run/config.json a.saved || { echo "FAIL: a refused run changed config.json"; exit 1; }
