@@ -76,7 +76,7 @@ static int cat(const char *data, workload *w)
 {
     char dir[4096];
     snprintf(dir, sizeof dir, "%s/anim/cat_walk", data);
-    tcb_load_opts o = {TCB_NORM_FIRST_FRAME, 100, 0, NULL, 0};
+    tcb_load_opts o = {TCB_NORM_FIRST_FRAME, 100, 0, NULL, 0, NULL};
     tcb_sequence s;
     tcb_error err;
     if (tcb_sequence_load_objdir(dir, "cat_walk", &o, &s, &err)) return 0;

@@ -143,15 +143,19 @@ void tcb_atomic_abort(tcb_atomic_file *af)
     if (af->tmp[0]) unlink(af->tmp);
 }
 
+int tcb_atomic_fail(tcb_atomic_file *af, tcb_error *err)
+{
+    int e = errno;
+    tcb_atomic_abort(af);
+    return tcb_fail(err, TCB_ERR_IO, "%s: write failed: %s", af->path, strerror(e));
+}
+
 int tcb_write_file_atomic(const char *path, const void *data, size_t len, tcb_error *err)
 {
     tcb_atomic_file af;
     int rc = tcb_atomic_open(&af, path, err);
     if (rc) return rc;
-    if (len && fwrite(data, 1, len, af.fp) != len) {
-        tcb_atomic_abort(&af);
-        return tcb_fail(err, TCB_ERR_IO, "%s: short write", path);
-    }
+    if (len && fwrite(data, 1, len, af.fp) != len) return tcb_atomic_fail(&af, err);
     return tcb_atomic_commit(&af, err);
 }
 

@@ -106,9 +106,7 @@ int tcb_npy_save(const char *path, tcb_npy_dtype dtype, int ndim, const uint64_t
     tcb_atomic_file af;
     rc = tcb_atomic_open(&af, path, err);
     if (rc) return rc;
-    if (fwrite(prefix, 1, plen, af.fp) != plen || write_data(af.fp, data, count, item_size)) {
-        tcb_atomic_abort(&af);
-        return tcb_fail(err, TCB_ERR_IO, "%s: short write", path);
-    }
+    if (fwrite(prefix, 1, plen, af.fp) != plen || write_data(af.fp, data, count, item_size))
+        return tcb_atomic_fail(&af, err);
     return tcb_atomic_commit(&af, err);
 }

@@ -3,6 +3,9 @@
 #include "tcb/rng.h"
 
 #include <math.h>
+#include <string.h>
+
+#include "tcb/hash.h"
 
 static uint64_t splitmix64(uint64_t *x)
 {
@@ -24,9 +27,7 @@ void tcb_rng_seed_stream(tcb_rng *r, uint64_t seed, const char *label)
 {
     /* FNV-1a of the label, mixed with the seed: distinct labels give
      * unrelated streams for the same seed. */
-    uint64_t h = 0xcbf29ce484222325ULL;
-    for (const unsigned char *p = (const unsigned char *)label; p && *p; p++)
-        h = (h ^ *p) * 0x100000001b3ULL;
+    uint64_t h = tcb_fnv1a64(TCB_FNV1A64_OFFSET, label, label ? strlen(label) : 0);
     uint64_t x = seed ^ h;
     tcb_rng_seed(r, splitmix64(&x) ^ h);
 }

@@ -7,8 +7,11 @@
  *   /yaw        float64 [F]           (absent when not rotation-aligned)
  *   /blocks     compound {name: string[64], start, n_frames: int32} [B]
  *               (absent for a sequence without blocks)
- *   attributes on /: format_version, key, name, norm, norm_scale.
- * The file is written under a temporary name and renamed into place. */
+ *   attributes on /: format_version, key, name, norm, norm_scale, checksum
+ *   (FNV-1a 64 of the arrays and the normalization, sequence_checksum).
+ * The file is written under a temporary name and renamed into place. HDF5
+ * checksums its metadata but not the data, so the checksum is what tells a
+ * flipped bit in the vertices from a vertex. */
 #include <errno.h>
 #include <fcntl.h>
 #include <hdf5.h>
@@ -23,10 +26,12 @@
 #include "datasets/strbuf.h"
 #include "tcb/fsutil.h"
 #include "tcb/geometry.h"
+#include "tcb/hash.h"
 #include "tcb/sequence.h"
 
-/* Bump when the layout or the meaning of any field changes (4: /blocks). */
-#define CACHE_FORMAT_VERSION 4
+/* Bump when the layout or the meaning of any field changes (4: /blocks,
+ * 5: checksum). */
+#define CACHE_FORMAT_VERSION 5
 
 /* tcb_block as an HDF5 compound, the same in memory and in the file. */
 static hid_t block_type(void)
@@ -39,6 +44,29 @@ static hid_t block_type(void)
     if (str >= 0) H5Tclose(str);
     if (bad && t >= 0) H5Tclose(t);
     return bad ? -1 : t;
+}
+
+/* Every array as loaded, the normalization, and of the blocks what they
+ * mean (a name's bytes after its end are not kept by HDF5). */
+static uint64_t sequence_checksum(const tcb_sequence *s)
+{
+    size_t F = (size_t)s->n_frames, nv = F * (size_t)s->n_verts * 3, np = F * (size_t)s->pool_size * 3;
+    int norm = (int)s->norm;
+    uint64_t h = tcb_fnv1a64(TCB_FNV1A64_OFFSET, &norm, sizeof norm);
+    h = tcb_fnv1a64(h, &s->norm_scale, sizeof s->norm_scale);
+    h = tcb_fnv1a64(h, s->verts, nv * sizeof *s->verts);
+    h = tcb_fnv1a64(h, s->faces, (size_t)s->n_faces * 3 * sizeof *s->faces);
+    h = tcb_fnv1a64(h, s->areas, F * sizeof *s->areas);
+    h = tcb_fnv1a64(h, s->norm_shift, F * 3 * sizeof *s->norm_shift);
+    if (s->pools) h = tcb_fnv1a64(h, s->pools, np * sizeof *s->pools);
+    if (s->yaw) h = tcb_fnv1a64(h, s->yaw, F * sizeof *s->yaw);
+    for (int k = 0; k < s->n_blocks; k++) {
+        const tcb_block *b = &s->blocks[k];
+        h = tcb_fnv1a64(h, b->name, strnlen(b->name, sizeof b->name));
+        h = tcb_fnv1a64(h, &b->start, sizeof b->start);
+        h = tcb_fnv1a64(h, &b->n_frames, sizeof b->n_frames);
+    }
+    return h;
 }
 
 /* ---- writing ---------------------------------------------------------- */
@@ -76,6 +104,7 @@ static int write_attr_string(hid_t obj, const char *name, const char *value)
 static int write_contents(hid_t file, const tcb_sequence *s, const char *key)
 {
     const int version = CACHE_FORMAT_VERSION, norm = (int)s->norm;
+    const uint64_t checksum = sequence_checksum(s);
     hsize_t F = (hsize_t)s->n_frames, V = (hsize_t)s->n_verts, P = (hsize_t)s->pool_size;
     hsize_t verts_dims[3] = {F, V, 3}, faces_dims[2] = {(hsize_t)s->n_faces, 3};
     hsize_t shift_dims[2] = {F, 3}, pool_dims[3] = {F, P, 3};
@@ -83,6 +112,7 @@ static int write_contents(hid_t file, const tcb_sequence *s, const char *key)
               write_attr_string(file, "key", key) || write_attr_string(file, "name", s->name) ||
               write_attr(file, "norm", H5T_STD_I32LE, H5T_NATIVE_INT, &norm) ||
               write_attr(file, "norm_scale", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &s->norm_scale) ||
+              write_attr(file, "checksum", H5T_STD_U64LE, H5T_NATIVE_UINT64, &checksum) ||
               write_array(file, "verts", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, 3, verts_dims, s->verts) ||
               write_array(file, "faces", H5T_STD_I32LE, H5T_NATIVE_INT32, 2, faces_dims, s->faces) ||
               write_array(file, "areas", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, &F, s->areas) ||
@@ -296,7 +326,12 @@ static int read_contents(hid_t file, const char *path, tcb_sequence *out, tcb_er
     /* Bad ids would turn into out-of-bounds reads far from here. */
     for (size_t i = 0; i < 3 * (size_t)out->n_faces; i++)
         if (out->faces[i] < 0 || out->faces[i] >= out->n_verts) return corrupt(path, "face index out of range", err);
-    return read_blocks(file, path, out, err);
+    rc = read_blocks(file, path, out, err);
+    uint64_t checksum;
+    if (!rc && read_attr(file, "checksum", H5T_NATIVE_UINT64, &checksum) != 0) rc = corrupt(path, "no checksum", err);
+    if (!rc && checksum != sequence_checksum(out))
+        rc = corrupt(path, "checksum mismatch: the arrays changed after they were saved", err);
+    return rc;
 }
 
 int tcb_sequence_cache_load(const char *path, const char *key, tcb_sequence *out, tcb_error *err)
@@ -330,13 +365,6 @@ static int build_key(const char *name, const tcb_load_opts *o, int pool_size, co
                          (unsigned long long)o->pool_seed, o->align_samples, source);
 }
 
-static uint64_t fnv1a(const char *s)
-{
-    uint64_t h = 0xcbf29ce484222325ULL;
-    for (; *s; s++) h = (h ^ (unsigned char)*s) * 0x100000001b3ULL;
-    return h;
-}
-
 static int read_and_prepare(const char *name, const tcb_load_opts *o, tcb_raw_reader read, const void *ctx,
                             tcb_sequence *out, tcb_error *err)
 {
@@ -350,7 +378,7 @@ int tcb_cache_load(const char *name, const tcb_load_opts *opts, const char *sour
                    const void *ctx, tcb_sequence *out, tcb_error *err)
 {
     memset(out, 0, sizeof *out);
-    static const tcb_load_opts defaults = {TCB_NORM_NONE, TCB_DEFAULT_POOL_SIZE, 0, NULL, 0};
+    static const tcb_load_opts defaults = {TCB_NORM_NONE, TCB_DEFAULT_POOL_SIZE, 0, NULL, 0, NULL};
     const tcb_load_opts *o = opts ? opts : &defaults;
     if (!o->cache_dir || !*o->cache_dir) return read_and_prepare(name, o, read, ctx, out, err);
     tcb_strbuf key = {0};
@@ -360,11 +388,17 @@ int tcb_cache_load(const char *name, const tcb_load_opts *opts, const char *sour
     }
     char path[TCB_PATH_MAX];
     int rc = tcb_path_join(path, sizeof path, err, "%s/%s-%016llx.h5", o->cache_dir, name,
-                           (unsigned long long)fnv1a(key.s));
-    /* A stale, corrupt or unreadable entry is simply rebuilt. */
-    if (!rc && tcb_is_file(path) && tcb_sequence_cache_load(path, key.s, out, NULL) == TCB_OK) {
-        free(key.s);
-        return TCB_OK;
+                           (unsigned long long)tcb_fnv1a64(TCB_FNV1A64_OFFSET, key.s, strlen(key.s)));
+    /* A stale, corrupt or unreadable entry is rebuilt, never used, and
+     * said: a cache that keeps being rebuilt costs the parse every run. */
+    tcb_error ce = {0};
+    if (!rc && tcb_is_file(path)) {
+        if (tcb_sequence_cache_load(path, key.s, out, &ce) == TCB_OK) {
+            free(key.s);
+            return TCB_OK;
+        }
+        tcb_report_log(o->reporter, TCB_LOG_WARN, "sequence cache not reused: %s; reading the sequence again",
+                       ce.msg);
     }
     if (!rc) rc = read_and_prepare(name, o, read, ctx, out, err);
     if (!rc && (rc = tcb_sequence_cache_save(path, out, key.s, err))) tcb_sequence_free(out);

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "tcb/fsutil.h"
+#include "tcb/hash.h"
 
 /* libFuzzer calls the target with no context to carry state in, so the
  * scratch directory is the one process-wide variable: created on first
@@ -51,6 +52,20 @@ const char *fuzz_file(const char *name, const uint8_t *data, size_t size)
         perror(path);
         abort();
     }
+    return path;
+}
+
+const char *fuzz_file_checksummed(const char *name, const uint8_t *data, size_t size)
+{
+    uint8_t *copy = malloc(size + 1);
+    fuzz_require(copy != NULL, "memory");
+    memcpy(copy, data, size);
+    if (size >= 8) {
+        uint64_t h = tcb_fnv1a64(TCB_FNV1A64_OFFSET, copy, size - 8);
+        memcpy(copy + size - 8, &h, 8);
+    }
+    const char *path = fuzz_file(name, copy, size);
+    free(copy);
     return path;
 }
 

@@ -25,6 +25,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
  * a target must never report a harness failure as a finding. */
 const char *fuzz_file(const char *name, const uint8_t *data, size_t size);
 
+/* fuzz_file with the last 8 bytes replaced by the FNV-1a 64 of the bytes
+ * before them (tcb/hash.h), as the checkpoint formats end: random bytes
+ * never match a checksum, which would stop the search at the first check,
+ * so the checks behind it are what is searched (the checksum test itself
+ * is a unit test). Inputs shorter than 8 bytes are written as they are. */
+const char *fuzz_file_checksummed(const char *name, const uint8_t *data, size_t size);
+
 /* The scratch directory itself. */
 const char *fuzz_dir(void);
 

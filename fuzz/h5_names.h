@@ -6,11 +6,12 @@
 
 enum {
     CACHE_VERTS, CACHE_FACES, CACHE_AREAS, CACHE_NORM_SHIFT, CACHE_POOLS, CACHE_YAW, CACHE_BLOCKS,
-    CACHE_FORMAT_VERSION, CACHE_KEY, CACHE_NAME, CACHE_NORM, CACHE_NORM_SCALE, CACHE_OTHER, CACHE_N_NAMES
+    CACHE_FORMAT_VERSION, CACHE_KEY, CACHE_NAME, CACHE_NORM, CACHE_NORM_SCALE, CACHE_CHECKSUM, CACHE_OTHER,
+    CACHE_N_NAMES
 };
 static const char *const cache_names[CACHE_N_NAMES] = {
     "verts", "faces", "areas", "norm_shift", "pools", "yaw", "blocks",
-    "format_version", "key", "name", "norm", "norm_scale", "other"};
+    "format_version", "key", "name", "norm", "norm_scale", "checksum", "other"};
 /* The key the cache target loads with. */
 #define CACHE_KEY_TEXT "fuzz-key"
 

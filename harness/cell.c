@@ -82,11 +82,12 @@ static void save_checkpoint(const tcb_cell_job *job, void *self, double fit_s)
     const char *path = job->checkpoint;
     char tmp[TCB_PATH_MAX];
     tcb_error e = {0};
-    /* The record goes first: a published checkpoint always has one. */
-    int rc = tcb_fit_time_save(path, fit_s, &e);
-    if (!rc) rc = tcb_temp_path_for(path, tmp, sizeof tmp, &e);
+    int rc = tcb_temp_path_for(path, tmp, sizeof tmp, &e);
     if (!rc) {
         rc = job->ops->save(self, tmp, &e);
+        /* The record describes the file it is published with and goes
+         * first: a published checkpoint always has one. */
+        if (!rc) rc = tcb_model_record_save(job, tmp, fit_s, &e);
         if (!rc) rc = tcb_publish(tmp, path, &e);
         else remove(tmp);
     }
@@ -114,18 +115,6 @@ static int create_method(const tcb_cell_job *job, void **self, tcb_error *merr)
     return rc;
 }
 
-/* The fit time of a reused checkpoint; without its record (a checkpoint
- * from before records were kept) only the loading is counted, and said. */
-static double reused_fit_time(const tcb_cell_job *job)
-{
-    double fit_s = 0;
-    tcb_error e = {0};
-    if (tcb_fit_time_load(job->checkpoint, &fit_s, &e) == TCB_OK) return fit_s;
-    tcb_report_log(&job->reporter, TCB_LOG_WARN, "fit time unknown (%s): fit_s counts only loading the model",
-                   e.msg);
-    return 0;
-}
-
 /* What fit and prepare_pairs are told; resumed_fit_s may be NULL. */
 static tcb_fit_ctx fit_ctx(const tcb_cell_job *job, double *resumed_fit_s)
 {
@@ -147,8 +136,11 @@ static int prepare_method(const tcb_cell_job *job, void **self, double *fit_s, t
     if (rc) return rc;
     if (ops->load && job->reuse_checkpoint && tcb_is_file(job->checkpoint)) {
         tcb_error le = {0};
-        if (ops->load(*self, job->seq, job->checkpoint, &le) == TCB_OK) {
-            if (fit_s) *fit_s = reused_fit_time(job) + tcb_now_seconds() - t0;
+        double recorded = 0;
+        /* The record first: a file that is not this cell's is never loaded. */
+        if (tcb_model_record_check(job, &recorded, &le) == TCB_OK &&
+            ops->load(*self, job->seq, job->checkpoint, &le) == TCB_OK) {
+            if (fit_s) *fit_s = recorded + tcb_now_seconds() - t0;
             return TCB_OK;
         }
         if (job->require_checkpoint) {

@@ -108,8 +108,10 @@ static int write_lock_temp(const char *path, char *tmp, size_t size, tcb_error *
     int rc = tcb_temp_path_for(path, tmp, size, err);
     if (!rc) {
         FILE *f = fopen(tmp, "wb");
-        if (!f || fwrite(text, 1, (size_t)n, f) != (size_t)n || fclose(f))
-            rc = tcb_fail(err, TCB_ERR_IO, "%s: cannot write: %s", tmp, strerror(errno));
+        int written = f && fwrite(text, 1, (size_t)n, f) == (size_t)n;
+        if (f && fclose(f)) written = 0;
+        /* A full disk must not leave a temporary that no cleanup knows. */
+        if (!written) rc = tcb_fail(err, TCB_ERR_IO, "%s: cannot write: %s", tmp, strerror(errno)), unlink(tmp);
     }
     return rc;
 }

@@ -32,6 +32,13 @@ char *tcb_config_normalized_json(const tcb_config *c);
  * it is read (harness/config_overlay.c). */
 int tcb_config_apply_opts(cJSON *root, const char *origin, const tcb_config_opts *o, tcb_error *err);
 
+/* <run_dir>/config.json: created with cfg's normalized config when there
+ * is none; else compared with cfg on what decides the cells, and refused
+ * (TCB_ERR_INPUT, naming both configs and the first difference) when they
+ * differ, unless `force`; replaced with cfg's when not refused.
+ * (harness/run_config.c) */
+int tcb_run_dir_claim(const tcb_config *cfg, const char *run_dir, int force, tcb_error *err);
+
 /* Pieces of the runner the dry run shares (harness/runner.c): */
 /* the method is the one --only names, or every method without --only; */
 int tcb_run_selected(const tcb_run_opts *opts, const tcb_method_spec *m);
@@ -117,11 +124,12 @@ void tcb_cell_label(char *out, size_t size, const char *dataset, const char *seq
 int tcb_harness_load_plugins(const tcb_config *cfg, tcb_error *err);
 
 /* The sequence as the runner loads it for dataset d: generated or read
- * (through the cache), normalized, pools drawn, input settings set. On
- * failure *seq is freed and the message names dataset and sequence.
+ * (through the cache; a cache entry refused is said to `reporter`, which
+ * may be NULL), normalized, pools drawn, input settings set. On failure
+ * *seq is freed and the message names dataset and sequence.
  * (harness/runner.c) */
 int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, const char *name,
-                              tcb_sequence *seq, tcb_error *err);
+                              const tcb_reporter *reporter, tcb_sequence *seq, tcb_error *err);
 /* <splits_dir>/<dataset>/<sequence>.json: where the sequence's split lives. */
 int tcb_harness_split_path(const tcb_config *cfg, const tcb_dataset_spec *d, const tcb_sequence_spec *s,
                            char *path, size_t size, tcb_error *err);
@@ -158,12 +166,14 @@ typedef struct tcb_cell_job {
     const void *interrupt_arg;
 } tcb_cell_job;
 
-/* The seconds fitting a cell's model took, stored beside its checkpoint
- * (<checkpoint>.fit.json) before the checkpoint is published, so a reused
- * checkpoint still reports its fit time. Load fails (naming the file) when
- * the record is missing or malformed. (harness/fit_time.c) */
-int tcb_fit_time_save(const char *checkpoint, double fit_s, tcb_error *err);
-int tcb_fit_time_load(const char *checkpoint, double *fit_s, tcb_error *err);
+/* The record of a cell's model checkpoint (<checkpoint>.fit.json): the
+ * cell it was made for, the sequence's fingerprint, the file's size and
+ * hash, and the seconds the fit took (harness/model_record.c). Save
+ * describes `saved`, the file about to be published as job->checkpoint;
+ * check fails, naming the file and the reason, unless job->checkpoint is
+ * that file and this cell's, and gives the recorded fit time. */
+int tcb_model_record_save(const tcb_cell_job *job, const char *saved, double fit_s, tcb_error *err);
+int tcb_model_record_check(const tcb_cell_job *job, double *fit_s, tcb_error *err);
 
 /* A cell of a finished run picked by name, for `tcbench inspect` and
  * `tcbench frames` (harness/cell_target.c). */

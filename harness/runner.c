@@ -109,29 +109,12 @@ int tcb_run_check_methods(const tcb_config *cfg, const tcb_run_opts *opts, tcb_e
     return TCB_OK;
 }
 
-static int write_config(const run_state *st, tcb_error *err)
-{
-    char path[TCB_PATH_MAX];
-    int rc = tcb_path_join(path, sizeof path, err, "%s/config.json", st->run_dir);
-    if (rc) return rc;
-    remove_stale_temps(path);
-    size_t len = strlen(st->cfg->json_text);
-    char *text = malloc(len + 2);
-    if (!text) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
-    memcpy(text, st->cfg->json_text, len);
-    text[len] = '\n';
-    text[len + 1] = '\0';
-    rc = tcb_write_file_atomic(path, text, len + 1, err);
-    free(text);
-    return rc;
-}
-
 int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, const char *name,
-                              tcb_sequence *seq, tcb_error *err)
+                              const tcb_reporter *reporter, tcb_sequence *seq, tcb_error *err)
 {
     int rc;
     tcb_load_opts lo = {d->norm, cfg->pool_size, cfg->pool_seed, cfg->cache_dir[0] ? cfg->cache_dir : NULL,
-                        d->align_samples};
+                        d->align_samples, reporter};
     if (d->source == TCB_SOURCE_SYNTHETIC) {
         rc = tcb_synth_generate(name, d->seed, d->frames, seq, err);
         if (!rc) rc = tcb_sequence_prepare(seq, &lo, err);
@@ -162,7 +145,7 @@ int tcb_run_load_sequence(const tcb_config *cfg, const char *dataset, const char
     memset(out, 0, sizeof *out);
     int rc = tcb_config_find_sequence(cfg, dataset, sequence, &d, &s, err);
     if (!rc) rc = tcb_run_check_root(cfg, d, err);
-    return rc ? rc : tcb_harness_load_sequence(cfg, d, s->name, out, err);
+    return rc ? rc : tcb_harness_load_sequence(cfg, d, s->name, NULL, out, err);
 }
 
 int tcb_harness_split_path(const tcb_config *cfg, const tcb_dataset_spec *d, const tcb_sequence_spec *s,
@@ -361,7 +344,7 @@ static int run_sequence(const run_state *st, const tcb_dataset_spec *d, const tc
     char split_path[TCB_PATH_MAX];
     double t0 = tcb_now_seconds();
     tcb_report_log(&st->opts->reporter, TCB_LOG_INFO, "%s/%s: loading", d->name, s->name);
-    int rc = tcb_harness_load_sequence(st->cfg, d, s->name, &seq, err);
+    int rc = tcb_harness_load_sequence(st->cfg, d, s->name, &st->opts->reporter, &seq, err);
     if (rc) return rc;
     seq_ctx sc = {d, &seq, &split, split_path, tcb_now_seconds() - t0};
     rc = tcb_harness_obtain_split(st->cfg, d, s, &seq, split_path, sizeof split_path, &split, err);
@@ -416,7 +399,7 @@ int tcb_run(const tcb_config *cfg, const tcb_run_opts *opts, tcb_run_stats *stat
     int rc = tcb_harness_load_plugins(cfg, err);
     if (!rc) rc = tcb_run_check_methods(cfg, opts, err);
     if (!rc) rc = check_roots(cfg, err);
-    if (!rc) rc = write_config(&st, err);
+    if (!rc) rc = tcb_run_dir_claim(cfg, st.run_dir, opts->force, err);
     if (rc) return rc;
     tcb_git_revision(st.git_revision, sizeof st.git_revision);
     for (int k = 0, first = 0; k < cfg->n_datasets && !rc; k++) {

@@ -126,7 +126,7 @@ static int score_cell(const tcb_config *cfg, const tcb_score_opts *o, const targ
     tcb_split split = {0};
     char split_path[TCB_PATH_MAX];
     double t0 = tcb_now_seconds();
-    int rc = tcb_harness_load_sequence(cfg, t->d, t->s->name, &seq, err);
+    int rc = tcb_harness_load_sequence(cfg, t->d, t->s->name, NULL, &seq, err);
     if (rc) return rc;
     double load_s = tcb_now_seconds() - t0;
     rc = tcb_harness_obtain_split(cfg, t->d, t->s, &seq, split_path, sizeof split_path, &split, err);
@@ -144,10 +144,10 @@ int tcb_score(const tcb_config *cfg, const tcb_score_opts *o, char *cell_path, t
 {
     target t;
     char path[TCB_PATH_MAX], split_path[TCB_PATH_MAX];
+    const char *run_dir = o->output ? o->output : cfg->output;
     int rc = find_target(cfg, o, &t, err);
     if (!rc) rc = check_label(cfg, o->label, err);
-    if (!rc) rc = tcb_cell_path(path, sizeof path, o->output ? o->output : cfg->output, t.d->name, t.s->name,
-                                o->label, o->seed, err);
+    if (!rc) rc = tcb_cell_path(path, sizeof path, run_dir, t.d->name, t.s->name, o->label, o->seed, err);
     if (!rc && !o->force && tcb_is_file(path))
         rc = tcb_fail(err, TCB_ERR_INPUT, "%s exists: --force replaces it", path);
     if (!rc) rc = tcb_harness_split_path(cfg, t.d, t.s, split_path, sizeof split_path, err);
@@ -158,7 +158,11 @@ int tcb_score(const tcb_config *cfg, const tcb_score_opts *o, char *cell_path, t
     tcb_cell_result c;
     rc = score_cell(cfg, o, &t, &c, err);
     if (rc) return rc;
-    rc = tcb_cell_save(path, &c, err);
+    /* A scored cell joins the run directory's cells as `tcbench run`'s do:
+     * not those of another config (--force replaces a cell, it does not
+     * take a directory over). */
+    rc = tcb_run_dir_claim(cfg, run_dir, 0, err);
+    if (!rc) rc = tcb_cell_save(path, &c, err);
     if (!rc && cell_path) snprintf(cell_path, TCB_PATH_MAX, "%s", path);
     if (!rc && summary) *summary = c.summary;
     tcb_cell_free(&c);

@@ -6,15 +6,8 @@
 #include <string.h>
 
 #include "tcb/fsutil.h"
+#include "tcb/hash.h"
 
-/* FNV-1a 64: a corruption check, not a security measure. */
-static uint64_t fnv1a(uint64_t h, const void *data, size_t len)
-{
-    const unsigned char *p = data;
-    for (size_t k = 0; k < len; k++) h = (h ^ p[k]) * 0x100000001b3ULL;
-    return h;
-}
-#define FNV_OFFSET 0xcbf29ce484222325ULL
 
 static size_t settings_bytes(const tcb_ckpt_settings *s)
 {
@@ -35,7 +28,7 @@ static size_t file_bytes(const tcb_ckpt_settings *s, const tcb_ckpt_array *array
 
 static int put(tcb_atomic_file *af, uint64_t *h, const void *data, size_t len)
 {
-    *h = fnv1a(*h, data, len);
+    *h = tcb_fnv1a64(*h, data, len);
     return fwrite(data, 1, len, af->fp) == len;
 }
 
@@ -46,16 +39,13 @@ int tcb_train_ckpt_write(const char *path, const char magic[8], const tcb_ckpt_s
     tcb_atomic_file af;
     int rc = tcb_atomic_open(&af, path, err);
     if (rc) return rc;
-    uint64_t h = FNV_OFFSET;
+    uint64_t h = TCB_FNV1A64_OFFSET;
     int ok = put(&af, &h, magic, 8) && put(&af, &h, s->ints, (size_t)s->n_ints * sizeof(int64_t)) &&
              put(&af, &h, s->reals, (size_t)s->n_reals * sizeof(double)) &&
              put(&af, &h, &s->seed, sizeof s->seed) && put(&af, &h, p, sizeof *p);
     for (int k = 0; ok && k < n_arrays; k++) ok = put(&af, &h, arrays[k].data, arrays[k].n * sizeof(float));
     ok = ok && fwrite(&h, sizeof h, 1, af.fp) == 1;
-    if (!ok) {
-        tcb_atomic_abort(&af);
-        return tcb_fail(err, TCB_ERR_IO, "%s: write failed", path);
-    }
+    if (!ok) return tcb_atomic_fail(&af, err);
     return tcb_atomic_commit(&af, err);
 }
 
@@ -104,7 +94,7 @@ static int check_file(const char *buf, size_t len, const char magic[8], const ch
                         expect);
     uint64_t stored;
     memcpy(&stored, buf + len - sizeof stored, sizeof stored);
-    if (fnv1a(FNV_OFFSET, buf, len - sizeof stored) != stored)
+    if (tcb_fnv1a64(TCB_FNV1A64_OFFSET, buf, len - sizeof stored) != stored)
         return tcb_fail(err, TCB_ERR_INPUT, "%s: checksum mismatch (corrupted file)", path);
     return TCB_OK;
 }

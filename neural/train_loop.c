@@ -52,11 +52,21 @@ static int run(const tcb_train_loop *loop, const tcb_fit_ctx *ctx, tcb_error *er
         }
         int periodic = loop->checkpoint_every > 0 && done % loop->checkpoint_every == 0;
         int stop = !rc && done < total && tcb_fit_interrupted(ctx);
-        if (!rc && ckpt[0] && (periodic || stop) && done < total)
-            rc = loop->save(loop->trainer, earlier + tcb_now_seconds() - start, ckpt, err);
+        const char *said = ckpt[0] ? "; training state saved in " : " (no work directory: nothing saved)";
+        const char *where = ckpt;
+        if (!rc && ckpt[0] && (periodic || stop) && done < total) {
+            tcb_error se = {0};
+            /* A state that cannot be written (a full disk) costs only the
+             * resumption, not the training: the training goes on, and a
+             * failed cell would stay failed once the disk has room again. */
+            if (loop->save(loop->trainer, earlier + tcb_now_seconds() - start, ckpt, &se)) {
+                tcb_report_log(&ctx->reporter, TCB_LOG_WARN, "%s: training state not saved: %s", loop->name, se.msg);
+                said = " (the training state could not be saved)", where = "";
+            }
+        }
         if (!rc && stop)
-            return tcb_fail(err, TCB_ERR_INTERRUPTED, "stopped at iteration %lld of %lld%s%s", done, total,
-                            ckpt[0] ? "; training state saved in " : " (no work directory: nothing saved)", ckpt);
+            return tcb_fail(err, TCB_ERR_INTERRUPTED, "stopped at iteration %lld of %lld%s%s", done, total, said,
+                            where);
     }
     if (ctx->resumed_fit_s) *ctx->resumed_fit_s = earlier;
     if (!rc && ckpt[0]) remove(ckpt);

@@ -54,10 +54,7 @@ int tcb_weights_write(const char *path, const tcb_weight_parts *w, tcb_error *er
     tcb_atomic_file af;
     int rc = tcb_atomic_open(&af, path, err);
     if (rc) return rc;
-    if (!write_parts(af.fp, w)) {
-        tcb_atomic_abort(&af);
-        return tcb_fail(err, TCB_ERR_IO, "%s: write failed", path);
-    }
+    if (!write_parts(af.fp, w)) return tcb_atomic_fail(&af, err);
     return tcb_atomic_commit(&af, err);
 }
 
@@ -144,8 +141,7 @@ int tcb_model_file_write(const char *path, const char magic[8], uint64_t seed, c
     if (!rc) {
         int ok = fwrite(magic, 1, 8, af.fp) == 8 && fwrite(&seed, 8, 1, af.fp) == 1 &&
                  fwrite(&mlen, 8, 1, af.fp) == 1 && fwrite(text, 1, mlen, af.fp) == mlen && write_parts(af.fp, w);
-        if (ok) rc = tcb_atomic_commit(&af, err);
-        else tcb_atomic_abort(&af), rc = tcb_fail(err, TCB_ERR_IO, "%s: write failed", path);
+        rc = ok ? tcb_atomic_commit(&af, err) : tcb_atomic_fail(&af, err);
     }
     free(text);
     return rc;

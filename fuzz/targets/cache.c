@@ -1,6 +1,9 @@
 /* The HDF5 sequence cache (datasets/cache.c), structure-aware (see
  * fuzz/h5_program.h): a cache loaded has faces within its vertices and
- * finite coordinates, areas and pools. */
+ * finite coordinates, areas and pools. Its last check is the checksum of
+ * the arrays (format 5), which a program matches only by chance: the
+ * search covers every check before it, and the checksum's own tests are
+ * unit tests (tests/unit/test_cache.c). */
 #include <math.h>
 
 #include "fuzz/fuzz_util.h"

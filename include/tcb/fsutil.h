@@ -29,6 +29,9 @@ typedef struct tcb_atomic_file {
 int tcb_atomic_open(tcb_atomic_file *af, const char *path, tcb_error *err);
 int tcb_atomic_commit(tcb_atomic_file *af, tcb_error *err);
 void tcb_atomic_abort(tcb_atomic_file *af);
+/* Abort after a failed write through af->fp: TCB_ERR_IO "<path>: write
+ * failed: <the reason>" (a full disk says so). */
+int tcb_atomic_fail(tcb_atomic_file *af, tcb_error *err);
 
 /* For writers that need a path rather than a FILE* (HDF5): a unique
  * temporary name next to `path`, and the rename that publishes it. */

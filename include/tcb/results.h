@@ -1,11 +1,13 @@
 /* tcbench — the results store: one JSON file per cell, written atomically.
  *
  * Layout of a run directory:
- *     <run>/config.json                                  the config as run
+ *     <run>/config.json                                  the config as run; a run of a
+ *         config whose cells would differ is refused (harness/run_config.c)
  *     <run>/cells/<dataset>/<sequence>/<method>/seed_<s>.json
  *     <run>/work/<dataset>/<sequence>/<method>/seed_<s>/  method checkpoints
- *         (model.ckpt after fit, model.ckpt.fit.json its fit time, and a
- *         method's own training state while it fits)
+ *         (model.ckpt after fit, model.ckpt.fit.json its record: the cell
+ *         and sequence it was made for, its size and hash, its fit time;
+ *         and a method's own training state while it fits)
  *     <run>/report/                                      written by `tcbench report`
  * A cell file exists only once the cell finished (ok, failed or diverged);
  * `tcbench run` skips cells whose file exists, so a killed run resumes.

@@ -18,6 +18,7 @@
 
 #include "tcb/block.h"
 #include "tcb/error.h"
+#include "tcb/progress.h"
 #include "tcb/rng.h"
 
 #ifdef __cplusplus
@@ -100,6 +101,11 @@ int tcb_sequence_sample_pools(tcb_sequence *s, int pool_size, uint64_t seed,
 int tcb_sequence_draw_points(const tcb_sequence *s, int f, int n, int with_replacement,
                              tcb_rng *rng, float *out, tcb_error *err);
 
+/* FNV-1a of everything a method is given (name, sizes, input protocol,
+ * vertices, faces, pools, block starts): what files saved for one cell
+ * record, so that another sequence's are refused (datasets/fingerprint.c). */
+uint64_t tcb_sequence_fingerprint(const tcb_sequence *s);
+
 /* Write every frame as <dir>/mesh_NNNN.obj (atomically, one file each). */
 int tcb_sequence_write_objdir(const tcb_sequence *s, const char *dir, tcb_error *err);
 
@@ -114,6 +120,7 @@ typedef struct tcb_load_opts {
     const char *cache_dir; /* NULL: no cache */
     int align_samples;     /* > 0: rotation alignment (tcb/align.h) on that many
                             * points per frame; 0: none */
+    const tcb_reporter *reporter; /* told of a cache entry refused; NULL: silent */
 } tcb_load_opts;
 
 /* What every loader does after reading raw frames: normalize, align the
@@ -124,13 +131,15 @@ int tcb_sequence_prepare(tcb_sequence *s, const tcb_load_opts *o, tcb_error *err
 /* Read an OBJ directory, normalize and sample pools; with a cache_dir the
  * result is stored as HDF5 and later loads skip parsing. A cache entry is
  * reused only when its recorded source (file names, sizes, mtimes), options
- * and format version all match. */
+ * and format version all match and its arrays have their recorded
+ * checksum; any other is rebuilt, and said to opts->reporter. */
 int tcb_sequence_load_objdir(const char *dir, const char *name, const tcb_load_opts *opts,
                              tcb_sequence *out, tcb_error *err);
 
 /* The HDF5 cache file itself (also usable as an exchange format). `key` is an
  * opaque string that must match on load; a mismatch returns TCB_ERR_UNSUPPORTED
- * ("stale") so the caller re-parses. */
+ * ("stale") so the caller re-parses. Arrays whose checksum differs from the
+ * one saved with them (a flipped bit HDF5 does not see) are TCB_ERR_INPUT. */
 int tcb_sequence_cache_save(const char *path, const tcb_sequence *s, const char *key,
                             tcb_error *err);
 int tcb_sequence_cache_load(const char *path, const char *key, tcb_sequence *out,

@@ -4,7 +4,8 @@
 
 static const char *const int_names[] = {"latent",     "patches",      "uv_samples", "loss",
                                         "delta",      "iterations",   "input_points", "frames",
-                                        "pool_size",  "parameter count", "pairs"};
+                                        "pool_size",  "parameter count", "pairs",
+                                        "sequence fingerprint"};
 static const char *const real_names[] = {"lr", "alpha_mc", "alpha_sciso"};
 
 /* The checkpoint of t: its settings, weights and Adam's moments, and where
@@ -15,10 +16,10 @@ static tcb_ckpt_spec spec_of(tcb_atlas_trainer *t, const tcb_sequence *seq, uint
     const tcb_atlas_train_cfg *c = &t->cfg;
     size_t n = t->model->nparams;
     return (tcb_ckpt_spec){
-        .magic = "TCBATRN3", .what = "an atlas training checkpoint",
-        .n_ints = 11, .n_reals = 3, .n_arrays = 3, .int_names = int_names, .real_names = real_names,
+        .magic = "TCBATRN4", .what = "an atlas training checkpoint",
+        .n_ints = 12, .n_reals = 3, .n_arrays = 3, .int_names = int_names, .real_names = real_names,
         .ints = {t->model->C, t->model->P, c->M, c->loss, c->delta, c->iterations, t->N, seq->n_frames,
-                 seq->pool_size, (int64_t)n, c->pairs},
+                 seq->pool_size, (int64_t)n, c->pairs, (int64_t)tcb_sequence_fingerprint(seq)},
         .reals = {c->lr, c->alpha_mc, c->alpha_sciso},
         .seed = seed, .max_it = c->iterations,
         .arrays = {{t->model->params, n}, {t->adam.m, n}, {t->adam.v, n}},

@@ -1,11 +1,14 @@
 /* Training checkpoints of the atlas family (format neural/train_ckpt.h,
- * magic "TCBATRN3"; TCBATRN2 lacked the pairs mode): the settings below, the training's progress, and the
+ * magic "TCBATRN4"; TCBATRN3 lacked the sequence's fingerprint, TCBATRN2
+ * the pairs mode): the settings below, the training's progress, and the
  * weights and Adam's moments (params, m, v: nparams floats each).
  * Resuming with the same thread count ends bit-identical to an
  * uninterrupted training (tests/unit/test_atlas_ckpt.c).
  *
  * Settings (int64): latent C, patches P, uv_samples M, loss, delta,
- * iterations, input_points N, frames, pool_size, parameter count, pairs;
+ * iterations, input_points N, frames, pool_size, parameter count, pairs,
+ * the sequence's fingerprint (tcb_sequence_fingerprint: another sequence of
+ * the same sizes is another training);
  * (double): lr, alpha_mc, alpha_sciso; and the seed of the training
  * stream. A checkpoint of other settings is refused naming the first key
  * that differs. */

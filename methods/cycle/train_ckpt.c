@@ -4,7 +4,7 @@
 
 static const char *const int_names[] = {"C",      "Z",     "H",          "L",     "sampling",     "batch",
                                         "iterations", "warmup", "knn_k", "knn_points", "delta", "input points",
-                                        "frames", "pool_size", "parameter count"};
+                                        "frames", "pool_size", "parameter count", "sequence fingerprint"};
 static const char *const real_names[] = {"lr"};
 
 /* The checkpoint of t: its settings, weights, Adam's moments and the
@@ -16,11 +16,11 @@ static tcb_ckpt_spec spec_of(tcb_cc_trainer *t, const tcb_sequence *seq, uint64_
     const tcb_cc_dims *d = &t->net->d;
     size_t n = t->net->nparams;
     return (tcb_ckpt_spec){
-        .magic = "TCBCCTR1", .what = "a cc training checkpoint",
-        .n_ints = 15, .n_reals = 1, .n_arrays = 4, .int_names = int_names, .real_names = real_names,
+        .magic = "TCBCCTR2", .what = "a cc training checkpoint",
+        .n_ints = 16, .n_reals = 1, .n_arrays = 4, .int_names = int_names, .real_names = real_names,
         .ints = {d->C, d->Z, d->H, d->L, c->sampler.sampling, c->batch, c->iterations, c->warmup,
                  c->sampler.knn_k, c->sampler.knn_points, c->sampler.delta, t->N, seq->n_frames, seq->pool_size,
-                 (int64_t)n},
+                 (int64_t)n, (int64_t)tcb_sequence_fingerprint(seq)},
         .reals = {c->lr},
         .seed = seed, .max_it = c->iterations,
         .arrays = {{t->net->params, n}, {t->adam.m, n}, {t->adam.v, n}, {t->net->buffers, t->net->nbuffers}},

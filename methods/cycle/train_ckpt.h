@@ -1,5 +1,5 @@
 /* Training checkpoints of cc (format neural/train_ckpt.h, magic
- * "TCBCCTR1"): the settings below, the training's progress, and the
+ * "TCBCCTR2"; TCBCCTR1 lacked the sequence's fingerprint): the settings below, the training's progress, and the
  * weights, Adam's moments and the batch-norm running statistics (params,
  * m, v: nparams floats each; buffers: nbuffers). Resuming with the same
  * thread count ends bit-identical to an uninterrupted training
@@ -7,7 +7,7 @@
  *
  * Settings (int64): C, Z, H, L, sampling, batch, iterations, warmup,
  * knn_k, knn_points, delta, input points, frames, pool_size, parameter
- * count; (double): lr; and the seed of the training stream. A checkpoint
+ * count, the sequence's fingerprint (tcb_sequence_fingerprint); (double): lr; and the seed of the training stream. A checkpoint
  * of other settings is refused naming the first key that differs. */
 #ifndef TCB_CC_TRAIN_CKPT_H
 #define TCB_CC_TRAIN_CKPT_H

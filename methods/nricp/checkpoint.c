@@ -7,7 +7,7 @@
  *
  * Binary, host byte order (a cache for the machine that wrote it):
  *     char     magic[8]      "TCBNRICP"
- *     int32    version       2
+ *     int32    version       3
  *     int32    strategy, rounds, smooth, smooth_last, k
  *     int32    n_frames, n_verts
  *     uint64   FNV-1a hash of the sequence's vertex coordinates (and block starts)
@@ -15,36 +15,32 @@
  *              whose fit time its cell records)
  *     uint8    done[2][n_frames − 1]          (propagate_simple/bijective only)
  *     int32    maps[2][n_frames − 1][n_verts] (the same; rows not done are 0)
+ *     uint64   FNV-1a of every byte before it
  * Reading refuses a file written for another strategy, other parameters or
- * another sequence, a done flag other than 0 or 1, any map entry outside
- * the frame and, for propagate_bijective, a map that is not a permutation.
- * Version 1 (no seconds, no flags) is refused by its version: the run fits
- * again. */
+ * another sequence, one whose checksum does not match (a flipped bit can
+ * leave a valid vertex id), a done flag other than 0 or 1, any map entry
+ * outside the frame and, for propagate_bijective, a map that is not a
+ * permutation. Versions 1 (no seconds, no flags) and 2 (no checksum) are
+ * refused by their version: the run fits again. */
 #include <stdlib.h>
 #include <string.h>
 
 #include "methods/nricp/nricp_internal.h"
 #include "tcb/fsutil.h"
+#include "tcb/hash.h"
 
 #define MAGIC "TCBNRICP"
-#define VERSION 2
+#define VERSION 3
 #define N_FIELDS 8 /* the int32 fields after the magic */
 #define HEADER_BYTES (8 + N_FIELDS * 4 + 8 + 8)
-
-static uint64_t fnv1a(uint64_t h, const void *data, size_t len)
-{
-    const unsigned char *b = data;
-    for (size_t k = 0; k < len; k++) h = (h ^ b[k]) * 1099511628211ull;
-    return h;
-}
 
 /* The blocks decide which maps are registered (maps.c): they are hashed
  * too, after the vertices, so a sequence without blocks keeps its hash. */
 uint64_t nricp_sequence_hash(const tcb_sequence *seq)
 {
     size_t len = (size_t)seq->n_frames * seq->n_verts * 3 * sizeof(float);
-    uint64_t h = fnv1a(1469598103934665603ull, seq->verts, len);
-    for (int k = 0; k < seq->n_blocks; k++) h = fnv1a(h, &seq->blocks[k].start, sizeof seq->blocks[k].start);
+    uint64_t h = tcb_fnv1a64(TCB_FNV1A64_OFFSET, seq->verts, len);
+    for (int k = 0; k < seq->n_blocks; k++) h = tcb_fnv1a64(h, &seq->blocks[k].start, sizeof seq->blocks[k].start);
     return h;
 }
 
@@ -63,7 +59,7 @@ static size_t map_rows(const nricp_method *m)
 
 static size_t file_size(const nricp_method *m)
 {
-    return HEADER_BYTES + map_rows(m) * (1 + (size_t)m->n_verts * sizeof(int32_t));
+    return HEADER_BYTES + map_rows(m) * (1 + (size_t)m->n_verts * sizeof(int32_t)) + sizeof(uint64_t);
 }
 
 /* Only the rows marked done are read: the others may be in the middle of
@@ -86,6 +82,8 @@ int nricp_write_state(const nricp_method *m, const unsigned char *done, double f
         flags[r] = done ? done[r] : 1;
         if (flags[r]) memcpy(maps + r * row_bytes, m->maps + r * (size_t)m->n_verts, row_bytes);
     }
+    uint64_t sum = tcb_fnv1a64(TCB_FNV1A64_OFFSET, buf, len - sizeof sum);
+    memcpy(buf + len - sizeof sum, &sum, sizeof sum);
     int rc = tcb_write_file_atomic(path, buf, len, err);
     free(buf);
     return rc;
@@ -119,6 +117,10 @@ static int check_header(const nricp_method *m, const unsigned char *buf, size_t 
     if (len != file_size(m))
         return tcb_fail(err, TCB_ERR_INPUT, "%s: %zu bytes, expected %zu (truncated or padded)", path, len,
                         file_size(m));
+    uint64_t sum;
+    memcpy(&sum, buf + len - sizeof sum, sizeof sum);
+    if (tcb_fnv1a64(TCB_FNV1A64_OFFSET, buf, len - sizeof sum) != sum)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: checksum mismatch (corrupted file)", path);
     return TCB_OK;
 }
 

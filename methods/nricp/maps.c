@@ -109,13 +109,18 @@ static void resume(nricp_method *m, const tcb_fit_ctx *ctx, fit_state *st)
 }
 
 /* Marks a row of the maps done; saves the state when the last save is a
- * minute old. Called inside the critical section of the fit's loop. */
-static void finish_map(const nricp_method *m, const tcb_fit_ctx *ctx, fit_state *st, size_t row, tcb_error *err)
+ * minute old. Called inside the critical section of the fit's loop. A
+ * state that cannot be written (a full disk) costs only the resumption:
+ * the fit goes on, rather than fail a cell that would stay failed once the
+ * disk has room again. */
+static void finish_map(const nricp_method *m, const tcb_fit_ctx *ctx, fit_state *st, size_t row)
 {
     st->done[row] = 1;
     tcb_report_progress(&ctx->reporter, ++st->n_done, st->jobs, "nricp: consecutive maps");
-    if (st->path[0] && st->n_done < st->jobs && tcb_now_seconds() - st->saved_s >= SAVE_EVERY_S)
-        save_state(m, st, err);
+    tcb_error se = {0};
+    if (st->path[0] && st->n_done < st->jobs && tcb_now_seconds() - st->saved_s >= SAVE_EVERY_S &&
+        save_state(m, st, &se))
+        tcb_report_log(&ctx->reporter, TCB_LOG_WARN, "nricp: maps not saved: %s", se.msg);
 }
 
 static int compute_maps(nricp_method *m, const tcb_sequence *seq, const tcb_fit_ctx *ctx, fit_state *st,
@@ -134,7 +139,7 @@ static int compute_maps(nricp_method *m, const tcb_sequence *seq, const tcb_fit_
         if (st->done[row] || tcb_fit_interrupted(ctx)) continue;
         if (one_map(m, seq, a, b, m->maps + nricp_map_at(m, a, b), &errs[t])) continue;
 #pragma omp critical(nricp_progress)
-        finish_map(m, ctx, st, row, &errs[t]);
+        finish_map(m, ctx, st, row);
     }
     for (int t = 0; t < st->jobs; t++)
         if (errs[t].code) return t;
@@ -157,10 +162,15 @@ int nricp_fit_maps(nricp_method *m, const tcb_sequence *seq, const tcb_fit_ctx *
     int failed = rc ? -1 : compute_maps(m, seq, ctx, &st, errs);
     if (!rc && failed >= 0) rc = tcb_fail(err, errs[failed].code, "%s", errs[failed].msg);
     if (!rc && st.n_done < st.jobs) {
-        rc = st.path[0] ? save_state(m, &st, err) : TCB_OK;
-        if (!rc)
-            rc = tcb_fail(err, TCB_ERR_INTERRUPTED, "nricp: stopped after %d of %d consecutive maps%s%s", st.n_done,
-                          st.jobs, st.path[0] ? "; maps saved in " : " (no work directory: nothing saved)", st.path);
+        const char *said = st.path[0] ? "; maps saved in " : " (no work directory: nothing saved)", *where = st.path;
+        tcb_error se = {0};
+        /* Stopped either way: the cell resumes, whether or not the maps were kept. */
+        if (st.path[0] && save_state(m, &st, &se)) {
+            tcb_report_log(&ctx->reporter, TCB_LOG_WARN, "nricp: maps not saved: %s", se.msg);
+            said = " (the maps could not be saved)", where = "";
+        }
+        rc = tcb_fail(err, TCB_ERR_INTERRUPTED, "nricp: stopped after %d of %d consecutive maps%s%s", st.n_done,
+                      st.jobs, said, where);
     }
     if (!rc && ctx->resumed_fit_s) *ctx->resumed_fit_s = st.earlier_s;
     if (!rc && st.path[0]) remove(st.path);

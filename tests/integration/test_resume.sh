@@ -2,7 +2,8 @@
 # Resume: a run killed (SIGKILL) midway and rerun yields cell files identical
 # to an uninterrupted run (timings and peak RSS aside) and leaves no
 # temporaries; a finished run reruns as all skips; a checkpoint (good or
-# corrupt) gives the same cell as a fit; changed settings refuse to resume.
+# corrupt) gives the same cell as a fit, one without its record is fitted
+# again; changed settings refuse to resume.
 set -euo pipefail
 : "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
 source "$TCB_SOURCE_DIR/tests/integration/harness_methods.sh"
@@ -85,13 +86,22 @@ at_least_1000 "$(fit_s "$rcell")" ||
     { echo "FAIL: a reused checkpoint reports fit_s $(fit_s "$rcell")"; cat reused.log; exit 1; }
 rm "$rcell" resumed/work/synth/quadruped_trot/slow/seed_1/model.ckpt.fit.json
 "$TCBENCH" run resumed.json --out resumed --only slow 2> unrecorded.log
-grep -qF "fit time unknown" unrecorded.log || { echo "FAIL: a missing fit record is not said"; cat unrecorded.log; exit 1; }
+grep -qF "model.ckpt: not reused (resumed/work/synth/quadruped_trot/slow/seed_1/model.ckpt.fit.json: " unrecorded.log ||
+    { echo "FAIL: a checkpoint without its record was not refused"; cat unrecorded.log; exit 1; }
+at_least_1000 "$(fit_s "$rcell")" || { echo "FAIL: the refit reports fit_s $(fit_s "$rcell")"; exit 1; }
 
-# Cells made with other settings are not silently mixed in.
+# Cells made with other settings are not silently mixed in: another config
+# is refused by the run directory, and a cell of other params (left by a
+# --force of another config) by the cell file.
 sed 's/"noise": 0.01/"noise": 0.02/' grid.json > changed.json
 rc=0
 "$TCBENCH" run changed.json --out killed --quiet 2> changed.log || rc=$?
-[ "$rc" -eq 2 ] && grep -qF "was computed with another params" changed.log ||
+[ "$rc" -eq 2 ] && grep -qF "holds the cells of another config than changed.json (methods[2].params.noise: 0.01 there, 0.02 here)" changed.log ||
     { echo "FAIL: changed params resumed (exit $rc)"; cat changed.log; exit 1; }
 "$TCBENCH" run changed.json --out killed --quiet --only slow --force
+"$TCBENCH" run grid.json --out killed --quiet --only oracle --force
+rc=0
+"$TCBENCH" run grid.json --out killed --quiet 2> mixed.log || rc=$?
+[ "$rc" -eq 2 ] && grep -qF "was computed with another params" mixed.log ||
+    { echo "FAIL: a cell of other params resumed (exit $rc)"; cat mixed.log; exit 1; }
 echo "resume test passed"

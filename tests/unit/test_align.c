@@ -134,7 +134,7 @@ static void test_prepare_aligns_before_pools(void **state)
     tcb_sequence s;
     turned_walk(&s);
     tcb_error err = {0};
-    tcb_load_opts o = {TCB_NORM_PER_FRAME, 300, 5, NULL, SAMPLES};
+    tcb_load_opts o = {TCB_NORM_PER_FRAME, 300, 5, NULL, SAMPLES, NULL};
     assert_int_equal(tcb_sequence_prepare(&s, &o, &err), TCB_OK);
     assert_non_null(s.yaw);
     assert_int_equal(s.pool_size, 300);

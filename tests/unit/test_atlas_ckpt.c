@@ -253,7 +253,10 @@ static void test_damaged_and_foreign_refused(void **state)
     memcpy(buf, "TCBATRN2", 8); /* the format before the pairs mode was kept */
     rewrite(path, buf, len);
     expect_refused(t, &s, path, "magic");
-    memcpy(buf, "TCBATRN3", 8);
+    memcpy(buf, "TCBATRN3", 8); /* the format before the sequence's fingerprint was kept */
+    rewrite(path, buf, len);
+    expect_refused(t, &s, path, "magic");
+    memcpy(buf, "TCBATRN4", 8);
     rewrite(path, buf, len);
     double seconds;
     assert_int_equal(tcb_atlas_train_ckpt_load(t, &s, SEED, path, &seconds, &err), TCB_OK);
@@ -272,6 +275,13 @@ static void test_damaged_and_foreign_refused(void **state)
     t = new_trainer(&tiny_mca, wide, &s);
     expect_refused(t, &s, path, "latent is 32, this training has 64");
     tcb_atlas_trainer_free(t);
+    /* Another sequence of the same sizes: the fingerprint tells them apart. */
+    tcb_sequence other = make_seq();
+    other.pools[0] += 1e-3f;
+    t = new_trainer(&tiny_mca, m, &other);
+    expect_refused(t, &other, path, "sequence fingerprint is ");
+    tcb_atlas_trainer_free(t);
+    tcb_sequence_free(&other);
     tcb_atlas_model_free(wide), tcb_atlas_model_free(m);
     free(buf);
     tcb_sequence_free(&s);

@@ -169,7 +169,7 @@ static void test_run_load_sequence(void **state)
     tcb_error err = {0};
     assert_int_equal(tcb_config_load(path, &cfg, &err), TCB_OK);
     assert_int_equal(tcb_run_load_sequence(&cfg, "synth", "quadruped_walk", &got, &err), TCB_OK);
-    tcb_load_opts o = {TCB_NORM_FIRST_FRAME, 300, 4, NULL, 0};
+    tcb_load_opts o = {TCB_NORM_FIRST_FRAME, 300, 4, NULL, 0, NULL};
     assert_int_equal(tcb_synth_generate("quadruped_walk", 0, 8, &want, &err), TCB_OK);
     assert_int_equal(tcb_sequence_prepare(&want, &o, &err), TCB_OK);
     assert_int_equal(got.n_frames, 8);

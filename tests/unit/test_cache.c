@@ -61,7 +61,7 @@ static void load_fresh(const char *dir, tcb_sequence *s)
 {
     char frames[TCB_PATH_MAX];
     snprintf(frames, sizeof frames, "%s/frames", dir);
-    tcb_load_opts o = {TCB_NORM_FIRST_FRAME, 50, 3, NULL, 0};
+    tcb_load_opts o = {TCB_NORM_FIRST_FRAME, 50, 3, NULL, 0, NULL};
     tcb_error err = {0};
     assert_int_equal(tcb_sequence_load_objdir(frames, "pyramid", &o, s, &err), TCB_OK);
 }
@@ -165,12 +165,12 @@ static void test_old_format_is_stale(void **state)
     assert_non_null(strstr(err.msg, "stale cache (format 3"));
 }
 
-static void expect_corrupt(const char *path)
+static void expect_corrupt(const char *path, const char *why)
 {
     tcb_sequence s;
     tcb_error err = {0};
     assert_int_equal(tcb_sequence_cache_load(path, "k", &s, &err), TCB_ERR_INPUT);
-    if (!strstr(err.msg, path)) fail_msg("'%s' does not name %s", err.msg, path);
+    if (!strstr(err.msg, path) || !strstr(err.msg, why)) fail_msg("'%s' does not name %s and '%s'", err.msg, path, why);
     assert_null(s.verts);
 }
 
@@ -179,14 +179,14 @@ static void test_corrupt_and_foreign_files(void **state)
     const char *dir = *state;
     char path[TCB_PATH_MAX];
     tu_write_text(dir, "text.h5", "this is not HDF5\n", path, sizeof path);
-    expect_corrupt(path);
+    expect_corrupt(path, "not an HDF5 file");
 
     /* A valid HDF5 file that is not a cache. */
     snprintf(path, sizeof path, "%s/foreign.h5", dir);
     hid_t f = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     assert_true(f >= 0);
     H5Fclose(f);
-    expect_corrupt(path);
+    expect_corrupt(path, "no format_version");
 
     /* A real cache cut in half. */
     write_frames(dir, 3);
@@ -202,7 +202,20 @@ static void test_corrupt_and_foreign_files(void **state)
     snprintf(path, sizeof path, "%s/half.h5", dir);
     assert_int_equal(tcb_write_file_atomic(path, data, len / 2, &err), TCB_OK);
     free(data);
-    expect_corrupt(path);
+    expect_corrupt(path, "not a valid tcbench sequence cache");
+
+    /* One vertex coordinate changed in place: HDF5 checksums its metadata,
+     * not the data, so only the cache's own checksum sees it. */
+    snprintf(path, sizeof path, "%s/whole.h5", dir);
+    f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+    hid_t ds = H5Dopen2(f, "verts", H5P_DEFAULT), space = H5Dget_space(ds);
+    hsize_t at[3] = {1, 2, 0}, one = 1;
+    float moved = 0.125f;
+    hid_t mem = H5Screate_simple(1, &one, NULL);
+    assert_true(f >= 0 && ds >= 0 && H5Sselect_elements(space, H5S_SELECT_SET, 1, at) >= 0 &&
+                H5Dwrite(ds, H5T_NATIVE_FLOAT, mem, space, H5P_DEFAULT, &moved) >= 0);
+    H5Sclose(mem), H5Sclose(space), H5Dclose(ds), H5Fclose(f);
+    expect_corrupt(path, "checksum mismatch");
 
     snprintf(path, sizeof path, "%s/absent.h5", dir);
     assert_int_equal(tcb_sequence_cache_load(path, "k", &s, &err), TCB_ERR_IO);
@@ -250,7 +263,7 @@ static void test_load_objdir_uses_cache(void **state)
     snprintf(frames, sizeof frames, "%s/frames", dir);
     snprintf(cache, sizeof cache, "%s/cache", dir);
     snprintf(frame0, sizeof frame0, "%s/frames/mesh_0000.obj", dir);
-    tcb_load_opts o = {TCB_NORM_PER_FRAME, 40, 11, cache, 0};
+    tcb_load_opts o = {TCB_NORM_PER_FRAME, 40, 11, cache, 0, NULL};
     tcb_sequence first, second, plain;
     tcb_error err = {0};
     assert_int_equal(tcb_sequence_load_objdir(frames, NULL, &o, &first, &err), TCB_OK);
@@ -286,7 +299,7 @@ static void test_aligned_load_caches_yaw(void **state)
     char frames[TCB_PATH_MAX], cache[TCB_PATH_MAX];
     snprintf(frames, sizeof frames, "%s/frames", dir);
     snprintf(cache, sizeof cache, "%s/cache", dir);
-    tcb_load_opts o = {TCB_NORM_PER_FRAME, 40, 11, cache, 64};
+    tcb_load_opts o = {TCB_NORM_PER_FRAME, 40, 11, cache, 64, NULL};
     tcb_sequence first, again, plain;
     tcb_error err = {0};
     assert_int_equal(tcb_sequence_load_objdir(frames, NULL, &o, &first, &err), TCB_OK);
@@ -299,6 +312,15 @@ static void test_aligned_load_caches_yaw(void **state)
     tcb_sequence_free(&first), tcb_sequence_free(&again), tcb_sequence_free(&plain);
 }
 
+static char last_log[1024];
+
+static void on_log(void *ctx, tcb_log_level level, const char *msg)
+{
+    (void)ctx;
+    assert_int_equal(level, TCB_LOG_WARN);
+    snprintf(last_log, sizeof last_log, "%s", msg);
+}
+
 static void test_load_objdir_rebuilds_stale_entry(void **state)
 {
     const char *dir = *state;
@@ -306,7 +328,7 @@ static void test_load_objdir_rebuilds_stale_entry(void **state)
     char frames[TCB_PATH_MAX], cache[TCB_PATH_MAX];
     snprintf(frames, sizeof frames, "%s/frames", dir);
     snprintf(cache, sizeof cache, "%s/cache", dir);
-    tcb_load_opts o = {TCB_NORM_FIRST_FRAME, 0, 0, cache, 0}; /* 0: default pool size */
+    tcb_load_opts o = {TCB_NORM_FIRST_FRAME, 0, 0, cache, 0, NULL}; /* 0: default pool size */
     tcb_sequence a, b;
     tcb_error err = {0};
     assert_int_equal(tcb_sequence_load_objdir(frames, "p", &o, &a, &err), TCB_OK);
@@ -316,7 +338,9 @@ static void test_load_objdir_rebuilds_stale_entry(void **state)
     assert_int_equal(tcb_sequence_load_objdir(frames, "p", &o, &b, &err), TCB_OK);
     assert_int_equal(b.n_frames, 4);
     assert_int_equal(count_cache_files(cache), 2);
-    /* A corrupted entry is rebuilt, not reported. */
+    /* A corrupted entry is rebuilt, and said, naming it. */
+    tcb_reporter said = {NULL, on_log, NULL};
+    o.reporter = &said;
     DIR *d = opendir(cache);
     for (struct dirent *e; (e = readdir(d));) {
         if (e->d_name[0] == '.') continue;
@@ -327,6 +351,9 @@ static void test_load_objdir_rebuilds_stale_entry(void **state)
     tcb_sequence c;
     assert_int_equal(tcb_sequence_load_objdir(frames, "p", &o, &c, &err), TCB_OK);
     assert_same_sequence(&b, &c);
+    if (!strstr(last_log, "sequence cache not reused: ") || !strstr(last_log, cache) ||
+        !strstr(last_log, "not a valid tcbench sequence cache"))
+        fail_msg("warning '%s'", last_log);
     tcb_sequence_free(&a);
     tcb_sequence_free(&b);
     tcb_sequence_free(&c);

@@ -229,7 +229,10 @@ static void test_damaged_and_foreign_refused(void **state)
     memcpy(buf, "TCBATRN2", 8); /* an atlas training's */
     assert_int_equal(tcb_write_file_atomic(path, buf, len, &err), TCB_OK);
     expect_refused(t, &s, path, "not a cc training checkpoint");
-    memcpy(buf, "TCBCCTR1", 8);
+    memcpy(buf, "TCBCCTR1", 8); /* the format before the sequence's fingerprint was kept */
+    assert_int_equal(tcb_write_file_atomic(path, buf, len, &err), TCB_OK);
+    expect_refused(t, &s, path, "not a cc training checkpoint");
+    memcpy(buf, "TCBCCTR2", 8);
     assert_int_equal(tcb_write_file_atomic(path, buf, len, &err), TCB_OK);
     tcb_cc_trainer_free(t);
     tcb_cc_train_cfg other = make_cfg(TCB_CC_SAMPLE_KNN, 12, 2);

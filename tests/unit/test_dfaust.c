@@ -175,7 +175,7 @@ static void test_subject_selection(void **state)
 
 static void load(const char *dir, const char *cache, tcb_sequence *out)
 {
-    tcb_load_opts o = {TCB_NORM_NONE, 64, 7, cache, 0};
+    tcb_load_opts o = {TCB_NORM_NONE, 64, 7, cache, 0, NULL};
     tcb_error err = {0};
     if (tcb_sequence_load_dfaust(dir, SEQ, NULL, 0, &o, out, &err)) fail_msg("load: %s", err.msg);
 }
