@@ -39,12 +39,13 @@ printf '%s\n' "${targets[@]}" | xargs -P 2 -I{} bash -c 'one {}'
 printf '| target | executions | seconds | edges | features | corpus | findings |\n|:---|---:|---:|---:|---:|---:|:---|\n'
 for t in "${targets[@]}"; do
     log=logs/$t.log
+    [ -s "$log" ] || continue
     execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
     secs=$(sed -n 's/^Done [0-9]* runs in \([0-9]*\) second.*/\1/p' "$log" | tail -1)
-    last=$(grep -E '^#[0-9]+' "$log" | grep -E 'cov: ' | tail -1)
+    last=$(grep -E '^#[0-9]+.*cov: ' "$log" | tail -1 || true)
     cov=$(sed -n 's/.*cov: \([0-9]*\).*/\1/p' <<< "$last")
     ft=$(sed -n 's/.*ft: \([0-9]*\).*/\1/p' <<< "$last")
     corp=$(sed -n 's/.*corp: \([0-9]*\).*/\1/p' <<< "$last")
-    found=$(cd findings && ls "$t"-* 2> /dev/null | tr '\n' ' ')
+    found=$(cd findings && ls "$t"-* 2> /dev/null | tr '\n' ' ' || true)
     printf '| %s | %s | %s | %s | %s | %s | %s |\n' "$t" "${execs:-?}" "${secs:-?}" "${cov:-?}" "${ft:-?}" "${corp:-?}" "${found:-none}"
 done
