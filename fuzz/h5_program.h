@@ -9,7 +9,8 @@
  * The program is a list of records, each
  *   kind   1 byte   even: a dataset, odd: an attribute of the root group
  *   name   1 byte   index into the target's list of names (modulo)
- *   type   1 byte   modulo 6: int32, int64, float32, float64, uint8, string
+ *   type   1 byte   modulo 7: int32, int64, float32, float64, uint8, string,
+ *                   uint64
  *   rank   1 byte   modulo 4 (0: a scalar); a string is always a scalar
  *   dims   rank bytes, each modulo 64
  *   data   the elements, little-endian, count × size bytes; a string:
@@ -23,7 +24,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-enum { H5P_I32, H5P_I64, H5P_F32, H5P_F64, H5P_U8, H5P_STR, H5P_N_TYPES };
+enum { H5P_I32, H5P_I64, H5P_F32, H5P_F64, H5P_U8, H5P_STR, H5P_U64, H5P_N_TYPES };
 #define H5P_MAX_ELEMENTS 4096
 
 /* Runs the program data[0..size) into a new HDF5 file at path, names[k]
@@ -40,5 +41,12 @@ typedef struct h5prog_buf {
  * the elements in that type, little-endian as x86 keeps them. */
 void h5prog_add_array(h5prog_buf *b, int attribute, int name, int type, int rank, const int *dims, const void *data);
 void h5prog_add_string(h5prog_buf *b, int attribute, int name, const char *text);
+
+/* The program that rebuilds the HDF5 file at path: a record for each
+ * dataset and root attribute of names[0..n_names) it holds, in that order
+ * (a file written by the reader's own writer, checksum included, is the
+ * best seed). Objects of another type (a compound) are left out; one of
+ * more than the program's sizes allow, or an unreadable file, aborts. */
+void h5prog_from_file(h5prog_buf *b, const char *path, const char *const *names, int n_names);
 
 #endif

@@ -3,7 +3,6 @@
  * objects accept, and HDF5 programs (h5_program.h) that build valid files.
  *   make_seeds OUT_DIR   → OUT_DIR/<target>/<seed>
  * Deterministic: the same build writes the same bytes. */
-#include <hdf5.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -69,49 +68,36 @@ static void write_program(const char *dir, const char *target, const char *name,
     ok(tcb_write_file_atomic(path, b->bytes, b->len, &err), &err);
 }
 
-/* The format version the cache writes today, read from one it wrote. */
-static int32_t cache_version(const char *dir, const tcb_sequence *seq)
-{
-    char path[TCB_PATH_MAX];
-    path_of(path, dir, "work", "version.h5");
-    tcb_error err = {0};
-    ok(tcb_sequence_cache_save(path, seq, CACHE_KEY_TEXT, &err), &err);
-    int32_t version = -1;
-    hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
-    hid_t a = file < 0 ? -1 : H5Aopen(file, "format_version", H5P_DEFAULT);
-    if (a < 0 || H5Aread(a, H5T_NATIVE_INT32, &version) < 0) {
-        fprintf(stderr, "make_seeds: no format_version in %s\n", path);
-        exit(1);
-    }
-    H5Aclose(a), H5Fclose(file), remove(path);
-    return version;
-}
-
-/* A tetrahedron over 3 frames, as the cache writes it. */
-static void cache_program(const char *dir, const tcb_sequence *seq)
+/* A tetrahedron over 3 frames, saved by the cache's own writer (its
+ * checksum included) and turned into the program that rebuilds that file;
+ * and the same program without the pools. */
+static void cache_program(const char *dir)
 {
     static const float verts[3][4][3] = {{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
                                          {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 2}},
                                          {{0, 0, 0}, {2, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
     static const int32_t faces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
-    static const double areas[3] = {2.4, 3.1, 3.1}, shift[3][3] = {{0}}, scale = 1;
-    static const int32_t norm = 0;
-    const int32_t version = cache_version(dir, seq);
+    tcb_sequence s;
+    tcb_error err = {0};
+    ok(tcb_sequence_alloc(&s, "tet", 3, 4, 4, &err), &err);
+    memcpy(s.verts, verts, sizeof verts), memcpy(s.faces, faces, sizeof faces);
+    const tcb_load_opts opts = {.norm = TCB_NORM_FIRST_FRAME, .pool_size = 8, .pool_seed = 1};
+    ok(tcb_sequence_prepare(&s, &opts, &err), &err);
+    char path[TCB_PATH_MAX];
+    path_of(path, dir, "work", "tet.h5");
+    ok(tcb_sequence_cache_save(path, &s, CACHE_KEY_TEXT, &err), &err);
+    tcb_sequence_free(&s);
     h5prog_buf b = {0};
-    h5prog_add_array(&b, 0, CACHE_VERTS, H5P_F32, 3, (const int[]){3, 4, 3}, verts);
-    h5prog_add_array(&b, 0, CACHE_FACES, H5P_I32, 2, (const int[]){4, 3}, faces);
-    h5prog_add_array(&b, 0, CACHE_AREAS, H5P_F64, 1, (const int[]){3}, areas);
-    h5prog_add_array(&b, 0, CACHE_NORM_SHIFT, H5P_F64, 2, (const int[]){3, 3}, shift);
-    h5prog_add_array(&b, 1, CACHE_FORMAT_VERSION, H5P_I32, 0, NULL, &version);
-    h5prog_add_string(&b, 1, CACHE_KEY, CACHE_KEY_TEXT);
-    h5prog_add_string(&b, 1, CACHE_NAME, "tet");
-    h5prog_add_array(&b, 1, CACHE_NORM, H5P_I32, 0, NULL, &norm);
-    h5prog_add_array(&b, 1, CACHE_NORM_SCALE, H5P_F64, 0, NULL, &scale);
+    h5prog_from_file(&b, path, cache_names, CACHE_N_NAMES);
     write_program(dir, "cache", "tetrahedron.prog", &b);
-    h5prog_add_array(&b, 0, CACHE_POOLS, H5P_F32, 3, (const int[]){3, 4, 3}, verts);
-    h5prog_add_array(&b, 0, CACHE_YAW, H5P_F64, 1, (const int[]){3}, areas);
-    write_program(dir, "cache", "tetrahedron_pools_yaw.prog", &b);
     free(b.bytes);
+    const char *without_pools[CACHE_N_NAMES];
+    for (int k = 0; k < CACHE_N_NAMES; k++) without_pools[k] = k == CACHE_POOLS ? "absent" : cache_names[k];
+    h5prog_buf c = {0};
+    h5prog_from_file(&c, path, without_pools, CACHE_N_NAMES);
+    write_program(dir, "cache", "tetrahedron_checksum_mismatch.prog", &c);
+    free(c.bytes);
+    remove(path);
 }
 
 /* Two subjects of a tetrahedron, (V, 3, F) = (4, 3, 2). */
@@ -146,8 +132,8 @@ int main(int argc, char **argv)
     fitted_model(argv[1], "mca", &seq);
     fitted_model(argv[1], "cc", &seq);
     fitted_model(argv[1], "nricp", &seq);
-    cache_program(argv[1], &seq);
     tcb_sequence_free(&seq);
+    cache_program(argv[1]);
     dfaust_program(argv[1]);
     ok(tcb_empty_dir(work, &err), &err);
     remove(work);
