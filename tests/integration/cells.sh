@@ -1,6 +1,16 @@
 # Sourced by the integration tests that interrupt runs and compare them cell
 # by cell.
 
+# enter_temp_dir: a fresh temporary directory as $tmp and the working
+# directory, removed at exit, when a background run whose pid the test puts
+# in $pid is killed too.
+enter_temp_dir() {
+    tmp=$(mktemp -d)
+    pid=""
+    trap '[ -n "$pid" ] && kill -9 "$pid" 2>/dev/null; rm -rf "$tmp"' EXIT
+    cd "$tmp"
+}
+
 # same_cells A B: the same cell files with the same contents, but for the
 # fields that measure the machine rather than the method.
 same_cells() { compare_cells "$1" "$2" same; }

@@ -9,10 +9,7 @@ set -euo pipefail
 : "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
 source "$TCB_SOURCE_DIR/tests/integration/cells.sh"
 
-tmp=$(mktemp -d)
-pid=""
-trap '[ -n "$pid" ] && kill -9 "$pid" 2>/dev/null; rm -rf "$tmp"' EXIT
-cd "$tmp"
+enter_temp_dir
 
 for s in quadruped_walk quadruped_trot; do
     "$TCBENCH" datasets synth --out data --sequence $s --frames 4 2> /dev/null

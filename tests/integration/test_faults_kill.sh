@@ -14,10 +14,7 @@ source "$TCB_SOURCE_DIR/tests/integration/cells.sh"
 
 seed=${TCB_FAULT_SEED:-18}
 RANDOM=$seed
-tmp=$(mktemp -d)
-pid=""
-trap '[ -n "$pid" ] && kill -9 "$pid" 2>/dev/null; rm -rf "$tmp"' EXIT
-cd "$tmp"
+enter_temp_dir
 
 cat > grid.json <<'JSON'
 { "name": "kill", "splits_dir": "splits", "cache_dir": "", "seeds": [0], "threads": 1,

@@ -9,10 +9,7 @@ set -euo pipefail
 : "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
 source "$TCB_SOURCE_DIR/tests/integration/cells.sh"
 
-tmp=$(mktemp -d)
-pid=""
-trap '[ -n "$pid" ] && kill -9 "$pid" 2>/dev/null; rm -rf "$tmp"' EXIT
-cd "$tmp"
+enter_temp_dir
 
 cat > train.json <<'JSON'
 { "name": "train", "splits_dir": "splits", "cache_dir": "", "seeds": [0], "threads": 1,

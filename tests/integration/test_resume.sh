@@ -9,10 +9,7 @@ set -euo pipefail
 source "$TCB_SOURCE_DIR/tests/integration/harness_methods.sh"
 source "$TCB_SOURCE_DIR/tests/integration/cells.sh"
 
-tmp=$(mktemp -d)
-pid=""
-trap '[ -n "$pid" ] && kill -9 "$pid" 2>/dev/null; rm -rf "$tmp"' EXIT
-cd "$tmp"
+enter_temp_dir
 build_harness_methods "$tmp/libharness_methods.so"
 
 cat > grid.json <<JSON
