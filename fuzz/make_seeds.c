@@ -100,6 +100,23 @@ static void cache_program(const char *dir)
     remove(path);
 }
 
+/* OBJ frames in the forms the reader accepts: plain, v/vt/vn with
+ * polygons and relative indices, CRLF and comments. */
+static void obj_seeds(const char *dir)
+{
+    static const char *const files[][2] = {
+        {"tetrahedron.obj", "# a tetrahedron\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"},
+        {"quad_forms.obj", "o quad\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                           "vn 0 0 1\ns off\nusemtl skin\nf 1/1/1 2/2/1 3/3/1 4/4/1\nf -4//1 -2//1 -1//1\n"},
+        {"crlf_texcoords.obj", "v 0 0 0 1.0\nv 1e-3 0 0\nv 0 2.5e+1 0\r\nf 1/1 2/2 3/3 # comment\n\n"}};
+    for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
+        char path[TCB_PATH_MAX];
+        path_of(path, dir, "obj", files[k][0]);
+        tcb_error err = {0};
+        ok(tcb_write_file_atomic(path, files[k][1], strlen(files[k][1]), &err), &err);
+    }
+}
+
 /* Two subjects of a tetrahedron, (V, 3, F) = (4, 3, 2). */
 static void dfaust_program(const char *dir)
 {
@@ -135,6 +152,7 @@ int main(int argc, char **argv)
     tcb_sequence_free(&seq);
     cache_program(argv[1]);
     dfaust_program(argv[1]);
+    obj_seeds(argv[1]);
     ok(tcb_empty_dir(work, &err), &err);
     remove(work);
     return 0;
