@@ -60,6 +60,22 @@ static void fitted_model(const char *dir, const char *method, const tcb_sequence
     ops->destroy(self);
 }
 
+/* The deform chain of frame 0 to FUZZ_DEFORM_NEAR and _FAR, as an
+ * evaluation saves it. */
+static void deform_chain(const char *dir, const tcb_sequence *seq)
+{
+    const tcb_method_ops *ops = tcb_registry_find("nricp");
+    struct nricp_method *self = fuzz_tiny_deform(seq);
+    char work[TCB_PATH_MAX];
+    path_of(work, dir, "deform_chain", "");
+    tcb_error err = {0};
+    ok(tcb_mkdirs(work, &err), &err);
+    tcb_fit_ctx ctx = {.seed = FUZZ_TINY_SEED, .n_threads = 1, .work_dir = work};
+    static const int pairs[] = {0, FUZZ_DEFORM_NEAR, 0, FUZZ_DEFORM_FAR};
+    ok(ops->prepare_pairs(self, seq, pairs, 0, 2, &ctx, &err), &err);
+    ops->destroy(self);
+}
+
 static void write_program(const char *dir, const char *target, const char *name, const h5prog_buf *b)
 {
     char path[TCB_PATH_MAX];
@@ -149,6 +165,7 @@ int main(int argc, char **argv)
     fitted_model(argv[1], "mca", &seq);
     fitted_model(argv[1], "cc", &seq);
     fitted_model(argv[1], "nricp", &seq);
+    deform_chain(argv[1], &seq);
     tcb_sequence_free(&seq);
     cache_program(argv[1]);
     dfaust_program(argv[1]);

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The long fuzzing run: every target of a fuzz build until RUNS executions
 # or SECONDS seconds, whichever comes first, growing its corpus in
-# BUILD/fuzz/corpus/<target>, two targets at a time; then a table of
-# executions, time, coverage (edges, features), corpus size and findings.
+# BUILD/fuzz/corpus/<target>, TCB_FUZZ_JOBS targets at a time (default 2),
+# then a table of executions, time, coverage (edges, features), corpus
+# size and findings.
 #   fuzz/run_long.sh BUILD_DIR [RUNS [SECONDS [TARGET...]]]
 # BUILD_DIR is configured with CC=clang -DTCB_FUZZ=ON (fuzz/README.md).
 # A finding is left as BUILD_DIR/fuzz/findings/<target>-crash-* (or leak-,
@@ -34,7 +35,7 @@ one() {
 }
 export -f one
 export runs seconds src
-printf '%s\n' "${targets[@]}" | xargs -P 2 -I{} bash -c 'one {}'
+printf '%s\n' "${targets[@]}" | xargs -P "${TCB_FUZZ_JOBS:-2}" -I{} bash -c 'one {}'
 
 printf '| target | executions | seconds | edges | features | corpus | findings |\n|:---|---:|---:|---:|---:|---:|:---|\n'
 for t in "${targets[@]}"; do

@@ -45,6 +45,17 @@ void *fuzz_tiny_method(const char *method)
     return self;
 }
 
+struct nricp_method *fuzz_tiny_deform(const tcb_sequence *seq)
+{
+    const tcb_method_ops *ops = tcb_registry_find("nricp");
+    void *self = NULL;
+    tcb_error err = {0};
+    ok(ops->create("{\"strategy\": \"propagate_deform\", \"rounds\": 2}", &self, &err), &err);
+    tcb_fit_ctx ctx = {.seed = FUZZ_TINY_SEED, .n_threads = 1};
+    ok(ops->fit(self, seq, &ctx, &err), &err);
+    return self;
+}
+
 void fuzz_tiny_trainer(const tcb_sequence *seq, tcb_atlas_model **model, tcb_atlas_trainer **trainer)
 {
     static const tcb_atlas_train_cfg cfg = {.loss = TCB_ATLAS_LOSS_METRIC, .M = 200, .iterations = 24,

@@ -47,7 +47,7 @@ static int one_map(const nricp_method *m, const tcb_sequence *seq, int a, int b,
         return TCB_OK;
     }
     const float *pa = tcb_seq_frame(seq, a), *pb = tcb_seq_frame(seq, b);
-    const float *na = m->normals + (size_t)a * nv * 3, *nb = m->normals + (size_t)b * nv * 3;
+    const float *na = nricp_normals_of(m, a), *nb = nricp_normals_of(m, b);
     float *moved = malloc((size_t)nv * 3 * sizeof *moved);
     if (!moved) return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory");
     int rc = nricp_register(pa, na, nv, pb, nb, nv, &m->params, moved, err);

@@ -61,6 +61,7 @@ int nricp_prepare(nricp_method *m, const tcb_sequence *seq, tcb_error *err)
                         "nricp: sequence %s has %d frames of %d vertices (need at least 2 frames)", seq->name,
                         seq->n_frames, seq->n_verts);
     m->n_frames = seq->n_frames, m->n_verts = seq->n_verts;
+    nricp_chains_free(&m->chains); /* announced for the model this replaces */
     m->seq_hash = nricp_sequence_hash(seq);
     size_t frame = (size_t)seq->n_verts * 3;
     free(m->normals);
@@ -80,32 +81,6 @@ static int nricp_fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx
     return rc;
 }
 
-static const float *normals_of(const nricp_method *m, int f)
-{
-    return m->normals + (size_t)f * m->n_verts * 3;
-}
-
-/* X ← ν_{P_{k±1}}(X) from frame i to frame j, X starting as src with the
- * normals of frame i throughout (Thea writes the original normals back).
- * TCSR loops over range(i, j), so for j < i it returned P_i unchanged;
- * here j < i deforms through i−1, i−2, …, j. */
-static int deform_chain(const nricp_method *m, const tcb_sequence *seq, int i, int j,
-                        const float *src, float *out, tcb_error *err)
-{
-    int nv = m->n_verts, step = j > i ? 1 : -1, rc = TCB_OK;
-    memcpy(out, src, (size_t)nv * 3 * sizeof *out);
-    float *next = malloc((size_t)nv * 3 * sizeof *next);
-    if (!next) return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory");
-    for (int k = i; k != j && !rc; k += step) {
-        rc = nricp_register(out, normals_of(m, i), nv, tcb_seq_frame(seq, k + step),
-                            normals_of(m, k + step), nv, &m->params, next, err);
-        if (rc) tcb_error_prefix(err, "deforming frame %d onto frame %d: ", k, k + step);
-        else memcpy(out, next, (size_t)nv * 3 * sizeof *out);
-    }
-    free(next);
-    return rc;
-}
-
 static int compose_transfer(const nricp_method *m, const tcb_sequence *seq, int i, int j, float *out,
                             tcb_error *err)
 {
@@ -119,21 +94,44 @@ static int compose_transfer(const nricp_method *m, const tcb_sequence *seq, int 
     return TCB_OK;
 }
 
-static int nricp_transfer(void *self, const tcb_sequence *seq, int i, int j, const float *src, int n,
-                          float *out, tcb_rng *rng, tcb_error *err)
+/* A pair of the fitted frames; the propagating chains run through
+ * consecutive frames of one block. */
+static int check_pair(const nricp_method *m, const tcb_sequence *seq, int i, int j, tcb_error *err)
 {
-    (void)rng; /* deterministic: the inputs are the GT vertices themselves */
-    const nricp_method *m = self;
     if (!m->normals || m->n_frames != seq->n_frames || m->n_verts != seq->n_verts)
         return tcb_fail(err, TCB_ERR_INTERNAL, "nricp: transfer before fit on sequence %s", seq->name);
     if (i < 0 || j < 0 || i >= m->n_frames || j >= m->n_frames)
         return tcb_fail(err, TCB_ERR_INPUT, "nricp: pair %d->%d outside frames 0..%d", i, j, m->n_frames - 1);
     int lo, hi;
     tcb_seq_block_of(seq, i, &lo, &hi);
-    /* The propagating chains run through consecutive frames of one block. */
     if (m->strategy != NRICP_RANDOM && (j < lo || j >= hi))
         return tcb_fail(err, TCB_ERR_INPUT, "nricp: %s: pair %d->%d crosses the block boundary of [%d, %d)",
                         nricp_strategy_names[m->strategy], i, j, lo, hi);
+    return TCB_OK;
+}
+
+/* propagate_deform runs the announced pairs' chains at once (deform.c);
+ * the other strategies have nothing to prepare. */
+static int nricp_prepare_pairs(void *self, const tcb_sequence *seq, const int *pairs, int first, int n,
+                               const tcb_fit_ctx *ctx, tcb_error *err)
+{
+    (void)first;
+    nricp_method *m = self;
+    if (m->strategy != NRICP_DEFORM) return TCB_OK;
+    for (int p = 0; p < n; p++) {
+        int rc = check_pair(m, seq, pairs[2 * p], pairs[2 * p + 1], err);
+        if (rc) return rc;
+    }
+    return nricp_deform_pairs(m, seq, pairs, n, ctx, err);
+}
+
+static int nricp_transfer(void *self, const tcb_sequence *seq, int i, int j, const float *src, int n,
+                          float *out, tcb_rng *rng, tcb_error *err)
+{
+    (void)rng; /* deterministic: the inputs are the GT vertices themselves */
+    const nricp_method *m = self;
+    int rc = check_pair(m, seq, i, j, err);
+    if (rc) return rc;
     /* Normals and vertex maps exist only for whole frames of GT vertices. */
     if (n != m->n_verts)
         return tcb_fail(err, TCB_ERR_INPUT,
@@ -141,13 +139,13 @@ static int nricp_transfer(void *self, const tcb_sequence *seq, int i, int j, con
                         n);
     switch (m->strategy) {
     case NRICP_RANDOM:
-        return nricp_register(src, normals_of(m, i), n, tcb_seq_frame(seq, j), normals_of(m, j), n,
+        return nricp_register(src, nricp_normals_of(m, i), n, tcb_seq_frame(seq, j), nricp_normals_of(m, j), n,
                               &m->params, out, err);
     case NRICP_SIMPLE:
     case NRICP_BIJECTIVE:
         return compose_transfer(m, seq, i, j, out, err);
     case NRICP_DEFORM:
-        return deform_chain(m, seq, i, j, src, out, err);
+        return nricp_deform_transfer(m, seq, i, j, src, out, err);
     }
     return tcb_fail(err, TCB_ERR_INTERNAL, "nricp: unknown strategy %d", (int)m->strategy);
 }
@@ -176,9 +174,9 @@ static void nricp_estimate(void *self, const tcb_cost_query *q, tcb_cost_estimat
     double neighbor = REG_NEIGHBOR_S * nv * rounds, maps = 2.0 * (q->n_frames - 1);
     out->fit_s = nricp_uses_maps(m->strategy) ? maps * neighbor : 0;
     if (m->strategy == NRICP_BIJECTIVE) out->fit_s += maps * lap_seconds(q->n_verts);
-    /* random: one registration per pair; deform: |i - j| of them, (F + 1) / 3 on average */
+    /* random: one registration per pair; deform: the chains' steps (deform.c) */
     out->eval_s = m->strategy == NRICP_RANDOM   ? q->n_pairs * REG_RANDOM_S * nv * rounds
-                  : m->strategy == NRICP_DEFORM ? q->n_pairs * (q->n_frames + 1) / 3.0 * neighbor
+                  : m->strategy == NRICP_DEFORM ? nricp_deform_expected_steps(q->n_frames, q->n_pairs) * neighbor
                                                 : 0;
     snprintf(out->basis, sizeof out->basis,
              "%s: %.2f s per registration of %d points (crane-measured rate, 1 thread, Zen 4)", name,
@@ -191,6 +189,7 @@ static void nricp_destroy(void *self)
     if (!m) return;
     free(m->normals);
     free(m->maps);
+    nricp_chains_free(&m->chains);
     free(m);
 }
 
@@ -205,4 +204,5 @@ const tcb_method_ops tcb_method_nricp = {
     .load = nricp_load,
     .destroy = nricp_destroy,
     .estimate = nricp_estimate,
+    .prepare_pairs = nricp_prepare_pairs,
 };

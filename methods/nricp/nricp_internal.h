@@ -18,6 +18,19 @@ typedef enum nricp_strategy {
 
 extern const char *const nricp_strategy_names[]; /* NULL-terminated, indexed by nricp_strategy */
 
+/* A propagate_deform chain (deform.c): X from frame `source`, one step of
+ * `step` (±1) at a time, kept at each target frame, nearest first. */
+typedef struct nricp_chain {
+    int source, step, n_targets;
+    int *targets;  /* [n_targets] */
+    float *outs;   /* [n_targets][n_verts][3] */
+} nricp_chain;
+
+typedef struct nricp_chains {
+    int n;
+    nricp_chain *c;
+} nricp_chains;
+
 typedef struct nricp_method {
     nricp_strategy strategy;
     nricp_params params;
@@ -28,6 +41,9 @@ typedef struct nricp_method {
      * row k maps frame k+1 → k. */
     int32_t *maps;
     uint64_t seq_hash; /* nricp_sequence_hash of the fitted sequence */
+    /* propagate_deform: the chains of the pairs prepare_pairs announced
+     * (n = 0 before, and for the other strategies). */
+    nricp_chains chains;
 } nricp_method;
 
 static inline int nricp_uses_maps(nricp_strategy s)
@@ -38,6 +54,12 @@ static inline int nricp_uses_maps(nricp_strategy s)
 static inline size_t nricp_maps_len(const nricp_method *m)
 {
     return 2 * (size_t)(m->n_frames - 1) * (size_t)m->n_verts;
+}
+
+/* Frame f's vertex normals. */
+static inline const float *nricp_normals_of(const nricp_method *m, int f)
+{
+    return m->normals + (size_t)f * m->n_verts * 3;
 }
 
 /* The row of maps mapping frame a to the adjacent frame b = a ± 1, and its offset. */
@@ -61,6 +83,26 @@ int nricp_prepare(nricp_method *m, const tcb_sequence *seq, tcb_error *err);
 int nricp_fit_maps(nricp_method *m, const tcb_sequence *seq, const tcb_fit_ctx *ctx,
                    tcb_error *err);
 void nricp_compose(const nricp_method *m, int i, int j, int32_t *idx);
+
+/* deform.c: the chains of the n pairs (pairs[2p] → pairs[2p + 1]) into
+ * m->chains, in parallel (ctx->n_threads), each saved in ctx->work_dir
+ * when it ends and reused from there; a stop request ends it with
+ * TCB_ERR_INTERRUPTED. transfer takes an announced pair's X from there and
+ * runs the chain of any other. */
+int nricp_deform_pairs(nricp_method *m, const tcb_sequence *seq, const int *pairs, int n,
+                       const tcb_fit_ctx *ctx, tcb_error *err);
+int nricp_deform_transfer(const nricp_method *m, const tcb_sequence *seq, int i, int j, const float *src,
+                          float *out, tcb_error *err);
+void nricp_chains_free(nricp_chains *cs);
+/* Registrations the chains of n uniformly drawn pairs (j ≠ i) over F
+ * frames take, in expectation. */
+double nricp_deform_expected_steps(int n_frames, int n_pairs);
+
+/* deform_store.c: one finished chain per file. read fills c->outs of a
+ * chain whose source, step and targets are set. */
+int nricp_chain_path(const char *work_dir, const nricp_chain *c, char *path, size_t size, tcb_error *err);
+int nricp_chain_write(const nricp_method *m, const nricp_chain *c, const char *path, tcb_error *err);
+int nricp_chain_read(const nricp_method *m, nricp_chain *c, const char *path, tcb_error *err);
 
 /* checkpoint.c */
 uint64_t nricp_sequence_hash(const tcb_sequence *seq); /* FNV-1a of the vertices and block starts */

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SIGKILL at any moment (issue 18): a grid of every kind of work — a
 # stateless method, a training with frequent checkpoints, nrICP's
-# consecutive maps — is killed again and again, at seeded random moments
+# consecutive maps and deform chains — is killed again and again, at seeded random moments
 # and at chosen ones (mid-training after a checkpoint, mid-evaluation,
 # mid-registration). After every kill each cell file present is complete and
 # equal to an uninterrupted run's; the run resumed after the last kill
@@ -23,7 +23,8 @@ cat > grid.json <<'JSON'
                   "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
   "methods": [ { "name": "nearest" },
                { "name": "mca", "params": { "preset": "tiny", "iterations": 40, "checkpoint_every": 5 } },
-               { "name": "nricp", "params": { "strategy": "propagate_simple" } } ] }
+               { "name": "nricp", "params": { "strategy": "propagate_simple" } },
+               { "name": "deform", "method": "nricp", "params": { "strategy": "propagate_deform" } } ] }
 JSON
 now_ms() { echo $(($(date +%s%N) / 1000000)); }
 t0=$(now_ms)
@@ -55,6 +56,7 @@ done
 rm -rf killed
 kill_run training_saved
 kill_run logged "nricp: consecutive maps"
+kill_run logged "nricp: deform chains"
 kill_run logged "mca/seed 0: "
 kill_run past $(($(now_ms) + full_ms / 3))
 n=$((n + 1))

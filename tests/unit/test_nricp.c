@@ -382,7 +382,17 @@ static void test_register_degenerate_inputs(void **state)
 typedef struct progress_log {
     int calls;
     double done, total;
+    int warnings;
+    char last_warning[TCB_ERRMSG_MAX];
 } progress_log;
+
+static void on_log(void *ctx, tcb_log_level level, const char *msg)
+{
+    progress_log *l = ctx;
+    if (level != TCB_LOG_WARN) return;
+    l->warnings++;
+    snprintf(l->last_warning, sizeof l->last_warning, "%s", msg);
+}
 
 static void on_progress(void *ctx, double done, double total, const char *label)
 {
@@ -711,6 +721,191 @@ static void test_stopped_fit_resumes(void **state)
     tcb_sequence_free(&s);
 }
 
+/* ---- propagate_deform's chains (deform.c) ------------------------------------ */
+
+/* Shared sources and directions, a duplicate, an i = j pair. */
+static const int deform_pairs[][2] = {{0, 3}, {0, 4}, {0, 2}, {4, 1}, {4, 0}, {2, 2}, {0, 3}, {3, 1}, {1, 2}};
+#define N_DEFORM_PAIRS ((int)(sizeof deform_pairs / sizeof *deform_pairs))
+/* One chain per (source, direction) to its farthest target: 0 → 4 (4
+ * steps), 4 → 0 (4), 3 → 1 (2), 1 → 2 (1); one chain per pair would take
+ * 3 + 4 + 2 + 3 + 4 + 0 + 3 + 2 + 1 = 22. */
+#define DEFORM_STEPS 11
+
+static int prepare_in(void *self, const tcb_sequence *s, const char *dir, int threads, stop_after *stop,
+                      progress_log *log, tcb_error *err)
+{
+    tcb_fit_ctx ctx = {.seed = 1, .n_threads = threads, .work_dir = dir};
+    ctx.reporter = (tcb_reporter){on_progress, on_log, log};
+    if (stop) ctx.interrupted = stop_requested, ctx.interrupt_arg = stop;
+    return tcb_registry_find("nricp")->prepare_pairs(self, s, &deform_pairs[0][0], 0, N_DEFORM_PAIRS, &ctx, err);
+}
+
+/* Every pair's transfer equals the chain of its own, run pair by pair. */
+static void expect_pair_by_pair(void *prepared, const tcb_sequence *s)
+{
+    void *lone = fitted(s, all_strategies[3], 1, NULL);
+    float a[BLOB_VERTS * 3], b[BLOB_VERTS * 3];
+    for (int p = 0; p < N_DEFORM_PAIRS; p++) {
+        transfer(prepared, s, deform_pairs[p][0], deform_pairs[p][1], a);
+        transfer(lone, s, deform_pairs[p][0], deform_pairs[p][1], b);
+        assert_memory_equal(a, b, sizeof a);
+    }
+    tcb_registry_find("nricp")->destroy(lone);
+}
+
+/* The announced pairs share their chains' prefixes: 11 registrations in
+ * place of 22, on two threads, with the bits of one chain per pair. */
+static void test_deform_chains_share_prefixes(void **state)
+{
+    (void)state;
+    tcb_sequence s;
+    make_blob_sequence(&s, SEQ_FRAMES);
+    void *self = fitted(&s, all_strategies[3], 2, NULL);
+    progress_log log = {0};
+    tcb_error err;
+    if (prepare_in(self, &s, NULL, 2, NULL, &log, &err)) fail_msg("prepare_pairs: %s", err.msg);
+    assert_int_equal(log.calls, DEFORM_STEPS);
+    assert_true(log.total == DEFORM_STEPS && log.done == DEFORM_STEPS);
+    expect_pair_by_pair(self, &s);
+    tcb_registry_find("nricp")->destroy(self);
+    tcb_sequence_free(&s);
+}
+
+static void corrupt_byte(const char *path, long at)
+{
+    char *buf;
+    size_t len;
+    tcb_error err;
+    assert_int_equal(tcb_read_file(path, &buf, &len, &err), TCB_OK);
+    buf[at < 0 ? (long)len + at : at] ^= 0x10;
+    assert_int_equal(tcb_write_file_atomic(path, buf, len, &err), TCB_OK);
+    free(buf);
+}
+
+/* A stopped batch keeps every finished chain in the work directory and
+ * the next one continues from them; a damaged chain file, or one written
+ * for other pairs, is said and deformed again. */
+static void test_deform_chains_resume(void **state)
+{
+    const char *dir = *state;
+    const tcb_method_ops *ops = tcb_registry_find("nricp");
+    tcb_sequence s;
+    make_blob_sequence(&s, SEQ_FRAMES);
+    char first[TCB_PATH_MAX];
+    snprintf(first, sizeof first, "%s/nricp_deform_0_forward.bin", dir);
+    void *self = fitted(&s, all_strategies[3], 1, NULL);
+    tcb_error err;
+    /* One thread, the longest first: 0 → 4 (4 steps) ends, 4 → 0 stops at its second. */
+    stop_after stop = {0, 5};
+    progress_log stopped = {0}, resumed = {0};
+    assert_int_equal(prepare_in(self, &s, dir, 1, &stop, &stopped, &err), TCB_ERR_INTERRUPTED);
+    if (!strstr(err.msg, "stopped after 1 of 4 deform chains") || !strstr(err.msg, dir)) fail_msg("%s", err.msg);
+    assert_true(tcb_is_file(first));
+    if (prepare_in(self, &s, dir, 1, NULL, &resumed, &err)) fail_msg("resume: %s", err.msg);
+    assert_true(resumed.total == DEFORM_STEPS - 4);
+    expect_pair_by_pair(self, &s);
+
+    /* A flipped bit of a deformed point: only the checksum sees it. */
+    corrupt_byte(first, -12);
+    progress_log redone = {0};
+    if (prepare_in(self, &s, dir, 2, NULL, &redone, &err)) fail_msg("redo: %s", err.msg);
+    assert_true(redone.total == 4);
+    if (redone.warnings != 1 || !strstr(redone.last_warning, first) || !strstr(redone.last_warning, "checksum"))
+        fail_msg("warning: '%s'", redone.last_warning);
+    expect_pair_by_pair(self, &s);
+
+    /* The chain 0 → 2 of another evaluation: frames 3 and 4 missing. */
+    static const int other[] = {0, 2};
+    remove(first);
+    tcb_fit_ctx ctx = {.seed = 1, .n_threads = 1, .work_dir = dir};
+    assert_int_equal(ops->prepare_pairs(self, &s, other, 0, 1, &ctx, &err), TCB_OK);
+    progress_log again = {0};
+    if (prepare_in(self, &s, dir, 1, NULL, &again, &err)) fail_msg("again: %s", err.msg);
+    assert_true(again.total == 4);
+    if (!strstr(again.last_warning, "no deformed cloud at frame 3")) fail_msg("warning: '%s'", again.last_warning);
+    expect_pair_by_pair(self, &s);
+    ops->destroy(self);
+    tcb_sequence_free(&s);
+}
+
+/* What a chain file refuses, each with the file's name and the cause. */
+static void test_deform_chain_file_checks(void **state)
+{
+    const char *dir = *state;
+    tcb_sequence s, other;
+    make_blob_sequence(&s, SEQ_FRAMES);
+    make_blob_sequence(&other, SEQ_FRAMES);
+    other.verts[0] += 0.5f;
+    void *self = fitted(&s, all_strategies[3], 1, NULL);
+    progress_log log = {0};
+    tcb_error err;
+    if (prepare_in(self, &s, dir, 1, NULL, &log, &err)) fail_msg("prepare_pairs: %s", err.msg);
+    nricp_method *m = self;
+    nricp_chain *c = &m->chains.c[0]; /* 0 → 4, targets 2, 3, 4 */
+    char path[TCB_PATH_MAX];
+    assert_int_equal(nricp_chain_path(dir, c, path, sizeof path, &err), TCB_OK);
+    assert_int_equal(nricp_chain_read(m, c, path, &err), TCB_OK);
+
+    nricp_chain backward = *c;
+    backward.step = -1;
+    assert_int_equal(nricp_chain_read(m, &backward, path, &err), TCB_ERR_INPUT);
+    assert_non_null(strstr(err.msg, "direction"));
+    void *moved = fitted(&other, all_strategies[3], 1, NULL);
+    assert_int_equal(nricp_chain_read(moved, c, path, &err), TCB_ERR_INPUT);
+    assert_non_null(strstr(err.msg, "another sequence"));
+    tcb_registry_find("nricp")->destroy(moved);
+
+    char *buf;
+    size_t len;
+    assert_int_equal(tcb_read_file(path, &buf, &len, &err), TCB_OK);
+    char cut[TCB_PATH_MAX];
+    snprintf(cut, sizeof cut, "%s/cut.bin", dir);
+    assert_int_equal(tcb_write_file_atomic(cut, buf, len - 4, &err), TCB_OK);
+    assert_int_equal(nricp_chain_read(m, c, cut, &err), TCB_ERR_INPUT);
+    if (!strstr(err.msg, cut) || !strstr(err.msg, "truncated")) fail_msg("%s", err.msg);
+    /* Checks behind the checksum: targets out of order, a NaN point. */
+    int32_t target = 1;
+    memcpy(buf + 56 + 4, &target, 4); /* targets 2, 1, 4 */
+    reseal(buf, len);
+    assert_int_equal(tcb_write_file_atomic(cut, buf, len, &err), TCB_OK);
+    assert_int_equal(nricp_chain_read(m, c, cut, &err), TCB_ERR_INPUT);
+    if (!strstr(err.msg, "not beyond frame 2 going forward")) fail_msg("%s", err.msg);
+    target = 3;
+    memcpy(buf + 56 + 4, &target, 4);
+    float nan = NAN;
+    memcpy(buf + len - 12, &nan, 4);
+    reseal(buf, len);
+    assert_int_equal(tcb_write_file_atomic(cut, buf, len, &err), TCB_OK);
+    assert_int_equal(nricp_chain_read(m, c, cut, &err), TCB_ERR_INPUT);
+    if (!strstr(err.msg, "not finite")) fail_msg("%s", err.msg);
+    free(buf);
+    tcb_registry_find("nricp")->destroy(self);
+    tcb_sequence_free(&s);
+    tcb_sequence_free(&other);
+}
+
+/* The dry run's expected chain length against the mean over drawn splits. */
+static void test_deform_expected_steps(void **state)
+{
+    (void)state;
+    enum { F = 40, P = 60, DRAWS = 400 };
+    tcb_rng rng;
+    tcb_rng_seed(&rng, 11);
+    double mean = 0;
+    for (int d = 0; d < DRAWS; d++) {
+        int reach[2][F] = {{0}};
+        for (int p = 0; p < P; p++) {
+            int i = (int)tcb_rng_below(&rng, F), j = (int)tcb_rng_below(&rng, F - 1);
+            j += j >= i;
+            int *r = &reach[j > i][i];
+            if (abs(j - i) > *r) *r = abs(j - i);
+        }
+        for (int i = 0; i < F; i++) mean += (double)(reach[0][i] + reach[1][i]) / DRAWS;
+    }
+    double want = nricp_deform_expected_steps(F, P);
+    if (fabs(mean - want) > 0.02 * want) fail_msg("expected %g steps, drawn splits %g", want, mean);
+}
+
 static void test_bad_params_rejected(void **state)
 {
     (void)state;
@@ -844,6 +1039,10 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_load_rejects_bad_checkpoints, tu_setup_tmpdir,
                                         tu_teardown_tmpdir),
         cmocka_unit_test_setup_teardown(test_stopped_fit_resumes, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test(test_deform_chains_share_prefixes),
+        cmocka_unit_test_setup_teardown(test_deform_chains_resume, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test_setup_teardown(test_deform_chain_file_checks, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test(test_deform_expected_steps),
         cmocka_unit_test(test_bad_params_rejected),
         cmocka_unit_test(test_input_shapes_checked),
         cmocka_unit_test_setup_teardown(test_blocks, tu_setup_tmpdir, tu_teardown_tmpdir),
