@@ -5,13 +5,14 @@
  * registrations, seconds and the ratios, and checks that both give the
  * same bits.
  *
- * Workload: the first `frames` frames of the walking cat's GT vertices
- * (<data>/anim/cat_walk, 1297 vertices), else of the synthetic quadruped;
- * `pairs` pairs drawn as a split draws them. The defaults keep crane's
- * density of evaluation pairs (500 over 175 frames), on which the sharing
- * depends.
+ * Workload: the first `frames` frames of an OBJ sequence's GT vertices
+ * (default the walking cat, 1297 vertices; AMA's crane has 10 002), else
+ * of the synthetic quadruped; `pairs` pairs drawn as a split draws them.
+ * The defaults keep crane's density of evaluation pairs (500 over 175
+ * frames), on which the sharing depends.
  *
- * usage: bench_nricp_deform [data_dir [frames [pairs]]]   (../shared/data, 40, 114) */
+ * usage: bench_nricp_deform [sequence_dir [frames [pairs]]]
+ *        (../shared/data/anim/cat_walk, 40, 114) */
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,15 +27,14 @@
 
 #define PROG "bench_nricp_deform"
 
-static void load(const char *data, int frames, tcb_sequence *s, const char **name)
+static void load(const char *dir, int frames, tcb_sequence *s, const char **name)
 {
-    char dir[4096];
-    snprintf(dir, sizeof dir, "%s/anim/cat_walk", data);
     tcb_load_opts o = {TCB_NORM_PER_FRAME, 100, 0, NULL, 0, NULL};
     tcb_error err;
-    *name = "cat_walk";
-    if (tcb_sequence_load_objdir(dir, "cat_walk", &o, s, &err)) {
-        printf("(no %s: the synthetic quadruped instead)\n", dir);
+    const char *slash = strrchr(dir, '/');
+    *name = slash && slash[1] ? slash + 1 : dir;
+    if (tcb_sequence_load_objdir(dir, *name, &o, s, &err)) {
+        printf("(%s: the synthetic quadruped instead)\n", err.msg);
         *name = "quadruped_walk";
         if (tcb_synth_generate("quadruped_walk", 1, 0, s, &err)) bench_die(PROG, "synthetic: %s", err.msg);
     }
@@ -91,12 +91,12 @@ static double evaluate(const tcb_sequence *s, const tcb_split *sp, int threads, 
 
 int main(int argc, char **argv)
 {
-    const char *data = argc > 1 ? argv[1] : "../shared/data";
+    const char *dir = argc > 1 ? argv[1] : "../shared/data/anim/cat_walk";
     int frames = argc > 2 ? bench_positive_int(argv[2], "frames", "top of bench/nricp_deform.c") : 40;
     int pairs = argc > 3 ? bench_positive_int(argv[3], "pairs", "top of bench/nricp_deform.c") : 114;
     tcb_sequence s;
     const char *name;
-    load(data, frames, &s, &name);
+    load(dir, frames, &s, &name);
     tcb_split sp;
     tcb_error err;
     if (tcb_split_make("bench", name, TCB_ROLE_VALIDATION, s.n_frames, NULL, 0, pairs, 2021, &sp, &err))
