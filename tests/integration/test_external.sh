@@ -54,7 +54,7 @@ fake() { ext "$1" "\"$py\", \"$fake\", \"$2\"" "${3:-}"; }
 config ext.json '{ "name": "nearest" }' '{ "name": "oracle" }' \
     "$(ext icp "\"$py\", \"$ex/icp_nearest.py\"")" "$(ext skeleton "\"$py\", \"$ex/skeleton.py\"")" \
     "$(fake ids oracle)" "$(fake recon recon)" "$(fake fail fail)" "$(fake diverge diverge)" \
-    "$(fake timeout sleep '"timeout_s": 2')" "$(fake stubborn stubborn '"timeout_s": 2, "grace_s": 0.5')" \
+    "$(fake timeout sleep '"timeout_s": 4')" "$(fake stubborn stubborn '"timeout_s": 4, "grace_s": 0.5')" \
     "$(fake malformed malformed)" "$(fake missing missing)" "$(fake partial_recon partial_recon)" \
     "$(ext nocmd '"tcb-no-such-command"')" "$(ext nofile '"/nonexistent/tcb-cmd"')"
 "$TCBENCH" run ext.json --quiet 2> run.log || { cat run.log; exit 1; }
@@ -93,8 +93,8 @@ failed("fail", "failed", "fit: `", "external_fake.py fail fit` exited with statu
        absent=["line 5 |"])
 failed("diverge", "diverged", "exited with status 3: diverged", "loss is nan")
 for m in ["timeout", "stubborn"]:
-    c = failed(m, "failed", "did not finish within timeout_s = 2 s and was stopped", "its last lines: waiting")
-    assert c["timings"]["fit_s"] < 9, (m, c["timings"])  # stubborn: SIGKILL after the 0.5 s grace
+    c = failed(m, "failed", "did not finish within timeout_s = 4 s and was stopped", "its last lines: waiting")
+    assert c["timings"]["fit_s"] < 11, (m, c["timings"])  # stubborn: SIGKILL after the 0.5 s grace
     for pid in map(int, open(work + m + "/seed_0/model/pids").read().split()):
         try:
             state = open("/proc/%d/stat" % pid).read().rsplit(")", 1)[1].split()[0]
