@@ -175,19 +175,17 @@ static void nricp_estimate(void *self, const tcb_cost_query *q, tcb_cost_estimat
     }
     double rounds = m->params.rounds, nv = q->n_verts;
     double neighbor = REG_NEIGHBOR_S * nv * rounds, maps = 2.0 * (q->n_frames - 1);
-    double chain_step = REG_CHAIN_S * nv * rounds;
+    double rate = m->strategy == NRICP_RANDOM   ? REG_RANDOM_S * nv * rounds
+                  : m->strategy == NRICP_DEFORM ? REG_CHAIN_S * nv * rounds
+                                                : neighbor;
     out->fit_s = nricp_uses_maps(m->strategy) ? maps * neighbor : 0;
     if (m->strategy == NRICP_BIJECTIVE) out->fit_s += maps * lap_seconds(q->n_verts);
     /* random: one registration per pair; deform: the chains' steps
      * (deform.c), the chains spread over the cell's threads */
-    out->eval_s = m->strategy == NRICP_RANDOM ? q->n_pairs * REG_RANDOM_S * nv * rounds
-                  : m->strategy == NRICP_DEFORM
-                      ? nricp_deform_expected_steps(q->n_frames, q->n_pairs) * chain_step /
-                            (q->n_threads > 1 ? q->n_threads : 1)
-                      : 0;
-    double rate = m->strategy == NRICP_RANDOM   ? REG_RANDOM_S * nv * rounds
-                  : m->strategy == NRICP_DEFORM ? chain_step
-                                                : neighbor;
+    out->eval_s = m->strategy == NRICP_RANDOM   ? q->n_pairs * rate
+                  : m->strategy == NRICP_DEFORM ? nricp_deform_expected_steps(q->n_frames, q->n_pairs) * rate /
+                                                      (q->n_threads > 1 ? q->n_threads : 1)
+                                                : 0;
     snprintf(out->basis, sizeof out->basis,
              "%s: %.2f s per registration of %d points (crane-measured, per thread, Zen 4)", name, rate,
              q->n_verts);
