@@ -153,12 +153,12 @@ static int nricp_transfer(void *self, const tcb_sequence *seq, int i, int j, con
 /* Seconds one registration of n points takes per point and round, one
  * thread, Zen 4, measured on crane (10 002 vertices, 25 rounds): 2.9 s
  * between the frames of a random pair (the random strategy's evaluation,
- * 1489 s for 500 pairs), 1.1 s between consecutive frames, which start
- * closer (propagate_simple's fit, 388 s for 348 maps), and 0.50 s for a
- * deform chain's step (propagate_deform's evaluation, 16 482 steps in
- * 4136 s on two threads, both cores busy). */
+ * 1489 s for 500 pairs), 0.40 s between consecutive frames, which start
+ * closer (propagate_simple's fit, 138 s for 348 maps, the other core
+ * idle), and 0.50 s for a deform chain's step (propagate_deform's
+ * evaluation, 16 482 steps in 4136 s on two threads, both cores busy). */
 #define REG_RANDOM_S (2.9 / (10002.0 * 25))
-#define REG_NEIGHBOR_S (1.1 / (10002.0 * 25))
+#define REG_NEIGHBOR_S (0.40 / (10002.0 * 25))
 #define REG_CHAIN_S (0.50 / (10002.0 * 25))
 /* One dense assignment between consecutive frames of n points: bench_lap's
  * squared-distance costs, 1.7 s at n = 4000, growing as n^2.3. */
@@ -173,18 +173,19 @@ static void nricp_estimate(void *self, const tcb_cost_query *q, tcb_cost_estimat
         snprintf(out->basis, sizeof out->basis, "%s: grows with the vertex count (data absent)", name);
         return;
     }
-    double rounds = m->params.rounds, nv = q->n_verts;
+    double rounds = m->params.rounds, nv = q->n_verts, threads = q->n_threads > 1 ? q->n_threads : 1;
     double neighbor = REG_NEIGHBOR_S * nv * rounds, maps = 2.0 * (q->n_frames - 1);
     double rate = m->strategy == NRICP_RANDOM   ? REG_RANDOM_S * nv * rounds
                   : m->strategy == NRICP_DEFORM ? REG_CHAIN_S * nv * rounds
                                                 : neighbor;
-    out->fit_s = nricp_uses_maps(m->strategy) ? maps * neighbor : 0;
-    if (m->strategy == NRICP_BIJECTIVE) out->fit_s += maps * lap_seconds(q->n_verts);
+    /* the maps (registration, and for bijective the assignment) spread
+     * over the cell's threads (maps.c) */
+    out->fit_s = nricp_uses_maps(m->strategy) ? maps * neighbor / threads : 0;
+    if (m->strategy == NRICP_BIJECTIVE) out->fit_s += maps * lap_seconds(q->n_verts) / threads;
     /* random: one registration per pair; deform: the chains' steps
      * (deform.c), the chains spread over the cell's threads */
     out->eval_s = m->strategy == NRICP_RANDOM   ? q->n_pairs * rate
-                  : m->strategy == NRICP_DEFORM ? nricp_deform_expected_steps(q->n_frames, q->n_pairs) * rate /
-                                                      (q->n_threads > 1 ? q->n_threads : 1)
+                  : m->strategy == NRICP_DEFORM ? nricp_deform_expected_steps(q->n_frames, q->n_pairs) * rate / threads
                                                 : 0;
     snprintf(out->basis, sizeof out->basis,
              "%s: %.2f s per registration of %d points (crane-measured, per thread, Zen 4)", name, rate,
