@@ -45,13 +45,17 @@ PY
 }
 
 # kill_when PID COMMAND...: SIGKILL the run PID as soon as COMMAND succeeds
-# (polling for up to a minute), or let it be once it has exited.
+# (polling for up to a minute), or let it be once it has exited. COMMAND is
+# asked while the run is stopped (SIGSTOP), so the run is killed in the
+# state COMMAND saw: on a loaded machine a lock seen held could otherwise
+# be released before the kill lands.
 kill_when() {
     local pid=$1
     shift
     for _ in $(seq 3000); do
+        kill -STOP "$pid" 2>/dev/null || break
         "$@" && break
-        kill -0 "$pid" 2>/dev/null || break
+        kill -CONT "$pid" 2>/dev/null || break
         sleep 0.02
     done
     kill -9 "$pid" 2>/dev/null || true
