@@ -44,20 +44,30 @@ print("%d cells identical" % len(b))
 PY
 }
 
-# kill_when PID COMMAND...: SIGKILL the run PID as soon as COMMAND succeeds
-# (polling for up to a minute), or let it be once it has exited. COMMAND is
-# asked while the run is stopped (SIGSTOP), so the run is killed in the
-# state COMMAND saw: on a loaded machine a lock seen held could otherwise
-# be released before the kill lands.
-kill_when() {
+# stop_when PID COMMAND...: SIGSTOP the run PID as soon as COMMAND succeeds
+# (polling for up to a minute) and leave it stopped (status 0); status 1
+# when the run exited or COMMAND never succeeded (the run goes on). COMMAND
+# is asked while the run is stopped, so the run stays in the state COMMAND
+# saw: on a loaded machine a lock seen held could otherwise be released
+# before a signal sent after the look lands.
+stop_when() {
     local pid=$1
     shift
     for _ in $(seq 3000); do
-        kill -STOP "$pid" 2>/dev/null || break
-        "$@" && break
-        kill -CONT "$pid" 2>/dev/null || break
+        kill -STOP "$pid" 2>/dev/null || return 1
+        "$@" && return 0
+        kill -CONT "$pid" 2>/dev/null || return 1
         sleep 0.02
     done
+    return 1
+}
+
+# kill_when PID COMMAND...: SIGKILL the run PID in the state COMMAND saw
+# (stop_when), or after a minute, or let it be once it has exited.
+kill_when() {
+    local pid=$1
+    shift
+    stop_when "$pid" "$@" || true
     kill -9 "$pid" 2>/dev/null || true
     wait "$pid" 2>/dev/null || true
 }
