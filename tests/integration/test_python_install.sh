@@ -6,7 +6,8 @@
 # the source tree), the copy deleted, then `import tcbench` from an empty
 # directory in an empty environment (PATH and HOME only: no PYTHONPATH, no
 # TCBENCH_LIB): the library it loads is the one inside the venv, and it
-# computes. `pip uninstall` takes the library with it.
+# computes. `pip uninstall` takes the library with it; `pip install ./python`
+# fails saying to install from the root.
 # setup.py builds the library in TCBENCH_CMAKE_BUILD_DIR, here the test's own
 # build (only bringing tcbench_lib up to date: seconds, not a rebuild);
 # TCB_TEST_PIP_FRESH_BUILD=1 leaves it unset, so pip configures and builds a
@@ -43,6 +44,12 @@ if ! (cd "$tmp/home" && env "${build_dir[@]}" PIP_DISABLE_PIP_VERSION_CHECK=1 PI
 fi
 # A wheel for this platform (it carries a compiled library), not a pure one.
 grep -q "filename=tcbench-.*-linux_[a-z0-9_]*\.whl" "$tmp/pip.log" || { echo "FAIL: not a platform wheel"; cat "$tmp/pip.log"; exit 1; }
+# ./python is not the way, and says so.
+if (cd "$tmp/home" && PIP_DISABLE_PIP_VERSION_CHECK=1 "$tmp/venv/bin/pip" install --no-build-isolation --no-index \
+        "$tmp/src/python") > "$tmp/pip_python.log" 2>&1; then
+    echo "FAIL: pip install ./python succeeded"; exit 1
+fi
+grep -qF "install from the repository root: \`pip install .\` there" "$tmp/pip_python.log" || { cat "$tmp/pip_python.log"; exit 1; }
 rm -rf "$tmp/src"
 
 # A sanitized library (TCB_SANITIZE) loads into python only after the ASan runtime.
