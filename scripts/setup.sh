@@ -15,6 +15,7 @@ packages=(
   libopenblas-openmp-dev                  # dense linear algebra (the OpenMP build: one thread pool)
   libcmocka-dev                           # unit-test framework
   python3 python3-numpy python3-scipy     # tests: JSON comparisons, scipy reference for linear assignment
+  python3-pip python3-venv python3-setuptools python3-wheel  # `pip install .` of the Python binding, offline
 )
 if [ "${1:-}" = "--tests" ]; then
   packages+=(python3-torch)               # the atlas network and training step against PyTorch

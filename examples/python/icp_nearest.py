@@ -8,7 +8,9 @@ nearest vertex. It learns nothing, so fit only records that it ran; the
 protocol is in skeleton.py and docs/adding-a-method.md.
 
     "methods": [ { "name": "icp", "method": "external",
-                   "params": { "command": ["python3", "examples/python/icp_nearest.py"] } } ]
+                   "params": { "command": ["examples/python/icp_nearest.py"] } } ]
+
+run by $TCBENCH_PYTHON (or the params' "python"; else python3 from PATH).
 """
 import json
 import os

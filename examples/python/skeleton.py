@@ -10,6 +10,10 @@ and for transfer the pairs and where the predictions go. A non-zero exit
 fails the cell (exit 3: the training diverged); what you print goes to the
 cell's external.log, and its last lines into the failure's message.
 
+List it as  "command": ["path/to/skeleton.py"]: a .py command runs under
+the params' "python", else $TCBENCH_PYTHON (say, the venv with your torch),
+else python3 from PATH; the log and every failure name the one that ran.
+
 As it stands it is tcbench's `nearest` baseline: every vertex of frame i
 stays where it is, and tcbench projects it onto frame j's nearest vertex.
 The test suite checks that its cell is bit-identical to nearest's.

@@ -35,6 +35,9 @@
  *                                          frames across subjects)
  *         "sequences": [ { "name": "jumping_jacks", "role": "validation" } ] } ],
  *     "methods": [ { "name": "oracle" },
+ *                  { "name": "mine", "method": "external",   a program of yours (docs/adding-a-method.md §6);
+ *                    "params": { "command": ["mine.py", "--x"], a .py script runs under params "python", else
+ *                                "python": "venv/bin/python" } }, $TCBENCH_PYTHON, else python3 from PATH
  *                  { "name": "mca-cpu", "method": "mca", "params": { … },
  *                    "seeds": [0, 1, 2],          its own seeds instead of the config's
  *                    "datasets": ["dfaust"] } ] } only on these datasets (default: all)

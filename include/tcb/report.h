@@ -36,8 +36,9 @@ int tcb_report_reference(const char *run_dir, const char *reference, const char 
  * metrics in table units, plus per-metric tolerances. */
 int tcb_baseline_write(const char *run_dir, const char *baseline_path, tcb_error *err);
 
-/* Compare; prints a diff table to `out`; *n_drift = rows outside tolerance
- * (missing or extra cells count as drift). */
+/* Compare; prints a diff table to `out`; *n_drift = the baseline's rows
+ * outside tolerance or missing from the run. The run's rows the baseline
+ * does not name are listed as "not in the baseline" and never drift. */
 int tcb_check(const char *run_dir, const char *baseline_path, FILE *out, int *n_drift,
               tcb_error *err);
 

@@ -19,6 +19,7 @@ static void ext_destroy(void *self)
     if (!m) return;
     for (int k = 0; m->command && k < m->n_command; k++) free(m->command[k]);
     free(m->command);
+    free(m->python);
     free(m->pairs);
     free(m->ids);
     free(m);
@@ -131,7 +132,7 @@ static int ext_prepare_pairs(void *self, const tcb_sequence *seq, const int *pai
     if (!rc) rc = clear_outputs(m, err);
     if (!rc) rc = ext_write_manifest(m, seq, ctx, "transfer", err);
     if (!rc) rc = ext_run_step(m, "transfer", ctx, err);
-    if (!rc) rc = ext_check_outputs(m, err);
+    if (!rc) rc = ext_name_program(m, ext_check_outputs(m, err), err);
     if (rc) m->n = 0;
     return rc;
 }
@@ -152,7 +153,7 @@ static int ext_transfer(void *self, const tcb_sequence *seq, int i, int j, const
         return tcb_fail(err, TCB_ERR_INTERNAL, "external: transfers whole frames (%d points, not %d)", seq->n_verts, n);
     int rc = check_pair(m, m->next, i, j, err);
     if (rc) return rc;
-    return ext_read_transfer(m, seq, m->next++, out, err);
+    return ext_name_program(m, ext_read_transfer(m, seq, m->next++, out, err), err);
 }
 
 static int ext_reconstruct(void *self, const tcb_sequence *seq, int i, int j, int frame, tcb_rng *rng, float **pts,
@@ -163,7 +164,7 @@ static int ext_reconstruct(void *self, const tcb_sequence *seq, int i, int j, in
     *pts = NULL, *n = 0;
     if (!m->has_recon) return tcb_fail(err, TCB_ERR_UNSUPPORTED, "external: the command wrote no reconstructions");
     int rc = check_pair(m, m->next - 1, i, j, err);
-    return rc ? rc : ext_read_recon(m, m->next - 1, frame == i ? 'i' : 'j', pts, n, err);
+    return rc ? rc : ext_name_program(m, ext_read_recon(m, m->next - 1, frame == i ? 'i' : 'j', pts, n, err), err);
 }
 
 const tcb_method_ops tcb_method_external = {

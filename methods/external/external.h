@@ -34,6 +34,13 @@
  * cell is recorded as diverged rather than failed. */
 #define EXT_EXIT_DIVERGED 3
 
+/* The interpreter of a command whose program is a Python script (its first
+ * item ends in ".py"): params.python, else $TCBENCH_PYTHON, else python3
+ * from PATH (program.c). A command that names its interpreter itself
+ * (["python3", "m.py"]) runs as listed. */
+#define EXT_PYTHON_ENV "TCBENCH_PYTHON"
+#define EXT_PYTHON_DEFAULT "python3"
+
 /* Names in the work directory. */
 #define EXT_MANIFEST "manifest.json"
 #define EXT_LOG "external.log"
@@ -43,6 +50,10 @@
 typedef struct ext_method {
     char **command;       /* params.command, NULL-terminated */
     int n_command;
+    char *python;         /* a .py command's interpreter: params.python or $TCBENCH_PYTHON; NULL: the default */
+    const char *python_from; /* where python came from ("external.params.python", "TCBENCH_PYTHON"), NULL */
+    char program[TCB_PATH_MAX + 64]; /* what the last step ran, for messages: "/usr/bin/python3 [python3 from
+                                      * PATH]"; "" before the first */
     double timeout_s;     /* per run of the command; 0: none */
     double grace_s;       /* SIGTERM → SIGKILL when it is stopped */
     int n_frames, n_verts;   /* the fitted sequence's sizes (the checkpoint marker's) */
@@ -56,7 +67,8 @@ typedef struct ext_method {
     int32_t *ids;         /* [n_verts] scratch for predicted ids */
 } ext_method;
 
-/* params: {"command": [...], "timeout_s": s, "grace_s": s} (params.c). */
+/* params: {"command": [...], "python": path, "timeout_s": s, "grace_s": s}
+ * (params.c); python also from $TCBENCH_PYTHON. */
 int ext_params_parse(const char *params_json, ext_method *m, tcb_error *err);
 /* params.command as compact JSON (free with cJSON_free; NULL: out of
  * memory): what a fit's checkpoint marker records. */
@@ -74,11 +86,28 @@ int ext_export_pairs(const ext_method *m, tcb_error *err);
 int ext_write_manifest(const ext_method *m, const tcb_sequence *seq, const tcb_fit_ctx *ctx, const char *step,
                        tcb_error *err);
 
+/* program (command[0]) is a Python script: its name ends in ".py" (program.c). */
+int ext_is_script(const char *program);
+/* The command's argv for a step (program.c): `[interpreter] command... step
+ * manifest`, NULL-terminated, in *argv (free the array, not its strings);
+ * the interpreter first when command[0] is a .py script. */
+int ext_step_argv(const ext_method *m, const char *step, const char *manifest, char ***argv, tcb_error *err);
+/* argv[0]'s executable into path[TCB_PATH_MAX], absolute (process.h's
+ * ext_proc_resolve), and m->program set to say it and where it came from;
+ * an error naming the params key or variable that gave it when there is
+ * none. */
+int ext_resolve_program(ext_method *m, char *const *argv, char *path, tcb_error *err);
+/* A failure of the method after its command ran: rc, with err's message
+ * naming the program that ran ("; program: ..."); TCB_OK, interrupts and
+ * TCB_ERR_UNSUPPORTED (no reconstructions) pass unchanged. */
+int ext_name_program(const ext_method *m, int rc, tcb_error *err);
+
 /* Runs `command... step <work>/manifest.json` (step.c): TCB_OK when it
- * exits 0; otherwise an error saying how it ended, with its last lines;
- * TCB_ERR_INTERRUPTED on a stop request, TCB_ERR_NUMERIC on
- * EXT_EXIT_DIVERGED. */
-int ext_run_step(const ext_method *m, const char *step, const tcb_fit_ctx *ctx, tcb_error *err);
+ * exits 0; otherwise an error saying how it ended, naming the program that
+ * ran, with its last lines; TCB_ERR_INTERRUPTED on a stop request,
+ * TCB_ERR_NUMERIC on EXT_EXIT_DIVERGED. The log's header names the
+ * program too. */
+int ext_run_step(ext_method *m, const char *step, const tcb_fit_ctx *ctx, tcb_error *err);
 
 /* After the transfer step (outputs.c): every pred/<k>.npy of the batch
  * exists, and reconstructions for every pair or for none (sets has_recon). */

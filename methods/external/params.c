@@ -1,6 +1,6 @@
 /* external.params: the command as an argv list (no shell: what is listed
- * is what runs, quoting never matters), its time limit and the grace a
- * stopped command gets to save its state. */
+ * is what runs, quoting never matters), the interpreter of a .py command,
+ * its time limit and the grace a stopped command gets to save its state. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -34,13 +34,34 @@ static int parse_command(const cJSON *json, ext_method *m, tcb_error *err)
     return TCB_OK;
 }
 
+/* The interpreter of a .py command: params.python (this method's, so it
+ * wins), else $TCBENCH_PYTHON (the machine's), else none: python3 from PATH
+ * when the step runs. params.python beside a command that is not a .py
+ * script would be silently unused: refused. */
+static int parse_python(const cJSON *json, ext_method *m, tcb_error *err)
+{
+    const cJSON *p = cJSON_GetObjectItemCaseSensitive(json, "python");
+    const char *env = getenv(EXT_PYTHON_ENV), *value = NULL;
+    if (p && (!cJSON_IsString(p) || !p->valuestring[0]))
+        return tcb_fail(err, TCB_ERR_INPUT, WHERE ".python: expected a non-empty string (the interpreter of .py commands)");
+    if (p && !ext_is_script(m->command[0]))
+        return tcb_fail(err, TCB_ERR_INPUT,
+                        WHERE ".python: runs .py commands, but command[0] '%s' is not a .py script (list the script "
+                        "first: [\"method.py\", ...])", m->command[0]);
+    if (p) value = p->valuestring, m->python_from = WHERE ".python";
+    else if (env && env[0]) value = env, m->python_from = EXT_PYTHON_ENV;
+    if (value && !(m->python = strdup(value))) return tcb_fail(err, TCB_ERR_NOMEM, "external: out of memory");
+    return TCB_OK;
+}
+
 int ext_params_parse(const char *params_json, ext_method *m, tcb_error *err)
 {
-    static const char *const keys[] = {"command", "timeout_s", "grace_s", NULL};
+    static const char *const keys[] = {"command", "python", "timeout_s", "grace_s", NULL};
     cJSON *json;
     int rc = tcb_params_parse(params_json, WHERE, keys, &json, err);
     if (rc) return rc;
     rc = parse_command(json, m, err);
+    if (!rc) rc = parse_python(json, m, err);
     if (!rc) rc = tcb_json_num(json, "timeout_s", WHERE, 0, 0, 0, 1e9, &m->timeout_s, err);
     if (!rc) rc = tcb_json_num(json, "grace_s", WHERE, 0, DEFAULT_GRACE_S, 0, 3600, &m->grace_s, err);
     cJSON_Delete(json);

@@ -42,10 +42,20 @@ static int executable(const char *path)
     return stat(path, &st) == 0 && S_ISREG(st.st_mode) && access(path, X_OK) == 0;
 }
 
+/* path, made absolute against the current directory ("./" dropped). */
+static int absolute(const char *path, char *out, size_t size, tcb_error *err)
+{
+    if (path[0] == '/') return tcb_path_join(out, size, err, "%s", path);
+    char cwd[TCB_PATH_MAX];
+    if (!getcwd(cwd, sizeof cwd)) return tcb_fail(err, TCB_ERR_IO, "cannot read the current directory: %s", strerror(errno));
+    while (path[0] == '.' && path[1] == '/') path += 2;
+    return tcb_path_join(out, size, err, "%s/%s", cwd, path);
+}
+
 int ext_proc_resolve(const char *name, char *out, size_t size, tcb_error *err)
 {
     if (strchr(name, '/')) {
-        if (executable(name)) return tcb_path_join(out, size, err, "%s", name);
+        if (executable(name)) return absolute(name, out, size, err);
         return tcb_fail(err, TCB_ERR_INPUT, "'%s': %s", name,
                         tcb_is_file(name) ? "not executable" : "no such executable file");
     }
@@ -57,7 +67,7 @@ int ext_proc_resolve(const char *name, char *out, size_t size, tcb_error *err)
         /* An empty entry is the current directory, as for execvp. */
         if ((size_t)snprintf(cand, sizeof cand, "%.*s%s%s", (int)len, p, len ? "/" : "", name) < sizeof cand &&
             executable(cand))
-            return tcb_path_join(out, size, err, "%s", cand);
+            return absolute(cand, out, size, err);
         p += len;
         if (!*p) break;
     }
@@ -197,9 +207,11 @@ static void wait_child(const ext_proc_spec *s, pid_t pid, double t0, ext_proc_en
 
 int ext_proc_run(const ext_proc_spec *s, ext_proc_result *r, tcb_error *err)
 {
-    char path[TCB_PATH_MAX];
-    int rc = ext_proc_resolve(s->argv[0], path, sizeof path, err);
+    char resolved[TCB_PATH_MAX];
+    const char *path = s->path;
+    int rc = path ? TCB_OK : ext_proc_resolve(s->argv[0], resolved, sizeof resolved, err);
     if (rc) return rc;
+    if (!path) path = resolved;
     char **envp = build_env(s->env_set);
     if (!envp) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory for the environment");
     double t0 = tcb_now_seconds();

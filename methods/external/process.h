@@ -18,6 +18,7 @@ typedef struct ext_proc_spec {
     double grace_s;             /* SIGTERM → SIGKILL delay when it is stopped */
     int (*interrupted)(const void *arg); /* may be NULL; nonzero: stop the command now */
     const void *interrupt_arg;
+    const char *path;           /* the executable, as ext_proc_resolve gave it; NULL: argv[0] resolved here */
 } ext_proc_spec;
 
 typedef enum ext_proc_end {
@@ -42,7 +43,9 @@ int ext_proc_run(const ext_proc_spec *s, ext_proc_result *r, tcb_error *err);
 
 /* argv[0]'s executable: as given when it has a '/', else the first in
  * $PATH (a missing PATH searches /usr/local/bin:/usr/bin:/bin, as execvp
- * does); TCB_ERR_INPUT naming it when there is none. */
+ * does); TCB_ERR_INPUT naming it when there is none. The path is made
+ * absolute against the current directory, symlinks kept (a venv's
+ * bin/python is a symlink whose own path tells Python its environment). */
 int ext_proc_resolve(const char *name, char *out, size_t size, tcb_error *err);
 
 #endif

@@ -17,18 +17,20 @@
 /* What the harness puts before a method's message ("prepare_pairs 0-499: "). */
 #define TAIL_PREFIX_ROOM 48
 
-/* "python3 icp.py fit", cut to fit out[size]: how messages name the run. */
-static void shown_command(const ext_method *m, const char *step, char *out, size_t size)
+/* "python3 icp.py fit" (argv without the manifest), cut to fit out[size]:
+ * how messages name the run. */
+static void shown_command(char *const *argv, char *out, size_t size)
 {
     size_t used = 0;
     out[0] = '\0';
-    for (int k = 0; k <= m->n_command && used < size; k++)
-        used += (size_t)snprintf(out + used, size - used, "%s%s", k ? " " : "", k < m->n_command ? m->command[k] : step);
+    for (int k = 0; argv[k + 1] && used < size; k++)
+        used += (size_t)snprintf(out + used, size - used, "%s%s", k ? " " : "", argv[k]);
 }
 
-/* Appends the run's header to the log; *from: the log's length after it,
- * where the run's own output starts. */
-static int log_header(const char *log, const char *shown, long *from, tcb_error *err)
+/* Appends the run's header to the log, the command and the program that
+ * runs it; *from: the log's length after it, where the run's own output
+ * starts. */
+static int log_header(const char *log, const char *shown, const char *program, long *from, tcb_error *err)
 {
     FILE *f = fopen(log, "a");
     if (!f) return tcb_fail(err, TCB_ERR_IO, "%s: cannot open the log", log);
@@ -36,7 +38,7 @@ static int log_header(const char *log, const char *shown, long *from, tcb_error 
     time_t now = time(NULL);
     struct tm tm;
     strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", gmtime_r(&now, &tm));
-    fprintf(f, "==== tcbench external, %s: %s\n", when, shown);
+    fprintf(f, "==== tcbench external, %s: %s\n==== program: %s\n", when, shown, program);
     *from = ftell(f);
     return fclose(f) == 0 && *from >= 0 ? TCB_OK : tcb_fail(err, TCB_ERR_IO, "%s: cannot write the log", log);
 }
@@ -62,7 +64,8 @@ static int judge(const ext_proc_result *r, const ext_method *m, const char *show
         snprintf(how, sizeof how, "was stopped by the stop request (SIGTERM, SIGKILL after %g s)", m->grace_s);
     }
     char head[TCB_ERRMSG_MAX], tail[TAIL_CHARS];
-    int n = snprintf(head, sizeof head, "`%s` %s after %.1f s (log %s); ", shown, how, r->wall_s, log);
+    int n = snprintf(head, sizeof head, "`%s` %s after %.1f s (program %s, log %s); ", shown, how, r->wall_s,
+                     m->program, log);
     /* The tail gets what the message has left, keeping room for the
      * harness's prefix, so its last line (the exception) is never cut. */
     long room = (long)TCB_ERRMSG_MAX - n - (long)strlen("its last lines: ") - TAIL_PREFIX_ROOM;
@@ -82,28 +85,28 @@ static void child_env(const tcb_fit_ctx *ctx, char *threads, size_t size, char *
     env[n] = NULL;
 }
 
-int ext_run_step(const ext_method *m, const char *step, const tcb_fit_ctx *ctx, tcb_error *err)
+int ext_run_step(ext_method *m, const char *step, const tcb_fit_ctx *ctx, tcb_error *err)
 {
-    char log[TCB_PATH_MAX], manifest[TCB_PATH_MAX], shown[256], threads[32];
+    char log[TCB_PATH_MAX], manifest[TCB_PATH_MAX], program[TCB_PATH_MAX], shown[256], threads[32];
     long from = 0;
     if (tcb_fit_interrupted(ctx))
         return tcb_fail(err, TCB_ERR_INTERRUPTED, "stopped before the command's %s step started", step);
-    char **argv = calloc((size_t)m->n_command + 3, sizeof *argv);
-    if (!argv) return tcb_fail(err, TCB_ERR_NOMEM, "external: out of memory");
-    memcpy(argv, m->command, (size_t)m->n_command * sizeof *argv);
-    argv[m->n_command] = (char *)step, argv[m->n_command + 1] = manifest;
-    shown_command(m, step, shown, sizeof shown);
-    int rc = ext_path(m, EXT_LOG, log, err);
+    char **argv = NULL;
+    int rc = ext_step_argv(m, step, manifest, &argv, err);
+    if (!rc) rc = ext_path(m, EXT_LOG, log, err);
     if (!rc) rc = ext_path(m, EXT_MANIFEST, manifest, err);
-    if (!rc) rc = log_header(log, shown, &from, err);
+    if (!rc) rc = ext_resolve_program(m, argv, program, err);
+    if (!rc) shown_command(argv, shown, sizeof shown);
+    if (!rc) rc = log_header(log, shown, m->program, &from, err);
     char *env[3];
     child_env(ctx, threads, sizeof threads, env);
-    ext_proc_spec spec = {argv, env, log, m->timeout_s, m->grace_s, ctx->interrupted, ctx->interrupt_arg};
+    ext_proc_spec spec = {argv, env, log, m->timeout_s, m->grace_s, ctx->interrupted, ctx->interrupt_arg, program};
     ext_proc_result r;
     if (!rc) {
-        tcb_report_log(&ctx->reporter, TCB_LOG_INFO, "external: %s (output in %s)", shown, log);
+        tcb_report_log(&ctx->reporter, TCB_LOG_INFO, "external: %s (program %s, output in %s)", shown, m->program, log);
         rc = ext_proc_run(&spec, &r, err);
         if (rc) tcb_error_prefix(err, "external.params.command: ");
+        rc = ext_name_program(m, rc, err);
     }
     free(argv);
     return rc ? rc : judge(&r, m, shown, log, from, err);

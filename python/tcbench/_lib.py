@@ -4,11 +4,18 @@ The library is found, in order:
 
 1. ``TCBENCH_LIB``: the path of the shared library; when set, nothing else
    is tried (a wrong path is an error, not a fallback to another build).
-2. An installed package (``cmake --install``) has a generated ``_installed``
+2. The bundled copy: ``libtcbench.so`` beside these modules, which
+   ``pip install .`` puts there (setup.py builds it).
+3. A package installed by ``cmake --install`` has a generated ``_installed``
    module naming the library relative to the package: the library that was
-   installed with it.
-3. A source checkout: ``build/libtcbench.so`` beside ``python/``.
+   installed with it. A package without one is a source checkout's
+   python/tcbench, whose library is ``build/libtcbench.so`` beside
+   ``python/`` (CMake's default build directory).
 4. ``ctypes.util.find_library("tcbench")``: the system's library path.
+
+The library that comes with the package (2, 3) goes before any other, so
+an installed package never picks up a stray build; a checkout's build/ is
+tried only for a package that came with none.
 
 Only tcb_error is mirrored as a ctypes struct, checked against the layout
 the library reports (tcb_binding_info); everything else crosses as JSON
@@ -27,6 +34,8 @@ from pathlib import Path
 import numpy as np
 
 ENV_VAR = "TCBENCH_LIB"
+# The bundled copy's name (setup.py's BUNDLED).
+BUNDLED = "libtcbench.so"
 ERRMSG_MAX = 1024
 
 
@@ -49,7 +58,7 @@ def _candidates() -> list[tuple[str, Path | str]]:
     if explicit:
         return [(ENV_VAR, Path(explicit))]
     here = Path(__file__).resolve().parent
-    out: list[tuple[str, Path | str]] = []
+    out: list[tuple[str, Path | str]] = [("bundled", here / BUNDLED)]
     try:
         from . import _installed  # written by `cmake --install`
         out.append(("installed", here / _installed.LIBRARY))

@@ -84,6 +84,8 @@ conf method.json '{"methods": [{"name": "nope"}]}'
 row "an unknown method" run method.json
 conf params.json '{"methods": [{"name": "nricp", "params": {"rounds": 0}}]}'
 row "a method's bad params" run params.json
+conf python.json '{"methods": [{"name": "mine", "method": "external", "params": {"command": ["python3", "mine.py"], "python": "/usr/bin/python3"}}]}'
+row "external: \`python\` for a command that is not a .py script" run python.json
 conf root.json '{"datasets": [{"name": "files", "source": "objdir", "root": "nowhere", "sequences": [{"name": "s", "role": "test"}]}]}'
 row "a dataset root that does not exist" run root.json
 

@@ -12,7 +12,12 @@
 # reuse the fit; --force clears the command's model directory. A stop request
 # (SIGTERM to tcbench) stops the command gracefully in fit and in transfer,
 # exits 75, and the rerun finishes the cell (without refitting after a
-# stop in transfer). Skipped when /usr/bin/python3 lacks numpy or scipy.
+# stop in transfer). The program that ran is named, as an absolute path, in
+# the log and in every failure: a .py command runs under params.python,
+# else $TCBENCH_PYTHON, else python3 from PATH (here a shim without numpy,
+# first on PATH as a pyenv shim can be), and the examples run as .py
+# commands under TCBENCH_PYTHON. Skipped when /usr/bin/python3 lacks numpy
+# or scipy.
 set -euo pipefail
 : "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
 . "$(dirname "${BASH_SOURCE[0]}")/expect.sh"
@@ -51,8 +56,10 @@ JSON
 ext() { echo "{ \"name\": \"$1\", \"method\": \"external\", \"params\": { \"command\": [$2]${3:+, $3} } }"; }
 fake() { ext "$1" "\"$py\", \"$fake\", \"$2\"" "${3:-}"; }
 
+# The examples as a user lists them: the script alone, its interpreter from TCBENCH_PYTHON.
+export TCBENCH_PYTHON=$py
 config ext.json '{ "name": "nearest" }' '{ "name": "oracle" }' \
-    "$(ext icp "\"$py\", \"$ex/icp_nearest.py\"")" "$(ext skeleton "\"$py\", \"$ex/skeleton.py\"")" \
+    "$(ext icp "\"$ex/icp_nearest.py\"")" "$(ext skeleton "\"$ex/skeleton.py\"")" \
     "$(fake ids oracle)" "$(fake recon recon)" "$(fake fail fail)" "$(fake diverge diverge)" \
     "$(fake timeout sleep '"timeout_s": 4')" "$(fake stubborn stubborn '"timeout_s": 4, "grace_s": 0.5')" \
     "$(fake malformed malformed)" "$(fake missing missing)" "$(fake partial_recon partial_recon)" \
@@ -89,8 +96,8 @@ def failed(m, status, *texts, absent=()):
         assert t not in c["message"], (m, t, c["message"])
     return c
 lines = " | ".join("line %d" % n for n in range(6, 16))
-failed("fail", "failed", "fit: `", "external_fake.py fail fit` exited with status 2", "external.log); its last lines: " + lines,
-       absent=["line 5 |"])
+failed("fail", "failed", "fit: `", "external_fake.py fail fit` exited with status 2",
+       "(program /usr/bin/python3, log ", "external.log); its last lines: " + lines, absent=["line 5 |"])
 failed("diverge", "diverged", "exited with status 3: diverged", "loss is nan")
 for m in ["timeout", "stubborn"]:
     c = failed(m, "failed", "did not finish within timeout_s = 4 s and was stopped", "its last lines: waiting")
@@ -101,13 +108,61 @@ for m in ["timeout", "stubborn"]:
         except FileNotFoundError:
             continue
         assert state == "Z", (m, pid, "still running")
-failed("malformed", "failed", "(pair 0): ", "/pred/0.npy: not a .npy file")
-failed("missing", "failed", "prepare_pairs 0-19: ", "/pred/3.npy: no such file (the transfer step writes one prediction per pair)")
+failed("malformed", "failed", "(pair 0): ", "/pred/0.npy: not a .npy file", "NUMPY); program: /usr/bin/python3")
+failed("missing", "failed", "prepare_pairs 0-19: ", "/pred/3.npy: no such file (the transfer step writes one prediction per pair); program: /usr/bin/python3")
 failed("partial_recon", "failed", "/pred/recon_2_i.npy: no such file (reconstructions are written for every pair or for none)")
 failed("nocmd", "failed", "fit: external.params.command: 'tcb-no-such-command': not found in PATH")
 failed("nofile", "failed", "fit: external.params.command: '/nonexistent/tcb-cmd': no such executable file")
+log = open(work + "icp/seed_0/external.log").read()
+assert "icp_nearest.py fit\n==== program: /usr/bin/python3 [TCBENCH_PYTHON]\n" in log, log[:300]
 print("external cells check out")
 PY
+
+# ---- which python: a shim `python3` without numpy first on PATH
+mkdir shim
+printf '#!/bin/sh\necho "ModuleNotFoundError: No module named numpy (the shim)" >&2\nexit 1\n' > shim/python3
+chmod +x shim/python3
+shim=$tmp/shim/python3
+skel=\"$ex/skeleton.py\"
+config which.json "$(ext default "$skel")" "$(ext listed "\"python3\", $skel")" \
+    "$(ext param "$skel" "\"python\": \"$py\"")" "$(ext param_over_env "$skel" "\"python\": \"$py\"")"
+# which_run OUT [NAME=VALUE...]: which.json run into OUT, PATH led by the shim, no TCBENCH_PYTHON unless given.
+which_run() {
+    local out=$1
+    shift
+    env -u TCBENCH_PYTHON PATH="$tmp/shim:$PATH" "$@" "$TCBENCH" run which.json --out "$out" --quiet 2> "$out.log" || true
+}
+which_run plain
+which_run env TCBENCH_PYTHON="$py"
+which_run env_shim TCBENCH_PYTHON=python3
+"$py" - "$shim" "$py" <<'PY'
+import json, sys
+shim, py = sys.argv[1:]
+def cell(out, m):
+    return json.load(open(f"{out}/cells/synth/quadruped_walk/{m}/seed_0.json"))
+def log(out, m):
+    return open(f"{out}/work/synth/quadruped_walk/{m}/seed_0/external.log").read()
+def ran(out, m, status, program):
+    c = cell(out, m)
+    assert c["status"] == status, (out, m, c["status"], c["message"])
+    assert f"==== program: {program}\n" in log(out, m), (out, m, program, log(out, m))
+    if status == "failed":
+        assert f"(program {program}, log " in c["message"], (out, m, c["message"])
+        assert "its last lines: ModuleNotFoundError: No module named numpy (the shim)" in c["message"], c["message"]
+ran("plain", "default", "failed", f"{shim} [python3 from PATH]")
+ran("plain", "listed", "failed", f"{shim} [python3 from PATH]")          # as listed: the shim
+ran("plain", "param", "ok", f"{py} [external.params.python]")
+ran("env", "default", "ok", f"{py} [TCBENCH_PYTHON]")
+ran("env", "listed", "failed", f"{shim} [python3 from PATH]")            # TCBENCH_PYTHON is for .py commands
+ran("env_shim", "default", "failed", f"{shim} [TCBENCH_PYTHON, python3 from PATH]")
+ran("env_shim", "param_over_env", "ok", f"{py} [external.params.python]")
+print("the program that ran is named")
+PY
+# An interpreter that is not there: the cell's message names where it came from.
+config nopython.json "$(ext default "$skel")"
+TCBENCH_PYTHON=/nonexistent/python "$TCBENCH" run nopython.json --out nopython --quiet 2> nopython.log || true
+grep -qF "TCBENCH_PYTHON (the interpreter of $ex/skeleton.py): '/nonexistent/python': no such executable file" \
+    nopython/cells/synth/quadruped_walk/default/seed_0.json || { cat nopython/cells/synth/quadruped_walk/default/seed_0.json nopython.log; exit 1; }
 
 # inspect reloads the fit (no second fit) and recomputes the same pair.
 log=run/work/synth/quadruped_walk/icp/seed_0/external.log

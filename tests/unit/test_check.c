@@ -1,6 +1,7 @@
 /* Regression check: a baseline written from a run checks clean; values
- * moved beyond their tolerance, changed statuses and missing or extra rows
- * drift; malformed baselines are input errors naming the file. */
+ * moved beyond their tolerance, changed statuses and rows the run lacks
+ * drift; rows the baseline does not name are listed as not in the baseline
+ * without drifting; malformed baselines are input errors naming the file. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -245,18 +246,54 @@ static void drop_row(cJSON *root, cJSON *row)
     cJSON_Delete(cJSON_DetachItemViaPointer(cJSON_GetObjectItem(root, "rows"), row));
 }
 
-static void test_missing_and_extra_rows_drift(void **state)
+/* The table's line for `row` (e.g. "anim/horse/NN "), in out[256]; 0 when there is none. */
+static int row_line(const char *table, const char *row, char *out)
+{
+    const char *p = strstr(table, row);
+    if (!p) return 0;
+    snprintf(out, 256, "%.*s", (int)strcspn(p, "\n"), p);
+    return 1;
+}
+
+/* row moved out of its tolerance, and horse/NN dropped. */
+static void drop_nn_shift_row(cJSON *root, cJSON *row)
+{
+    shift(row, 1.0);
+    for (cJSON *r = cJSON_GetObjectItem(root, "rows")->child; r; r = r->next)
+        if (!strcmp(cJSON_GetObjectItem(r, "method")->valuestring, "NN")) {
+            drop_row(root, r);
+            return;
+        }
+    fail_msg("no NN row");
+}
+
+static void test_rows_not_in_the_baseline_are_listed_not_judged(void **state)
 {
     fixture *f = *state;
-    char path[2048], *table, lines[8][256];
-    /* The run has a row the baseline lacks. */
+    char path[2048], *table, lines[8][256], line[256];
+    /* The run has a row the baseline lacks (a method scored beside the baseline's). */
     edited(f, "horse", "NN", drop_row, "dropped.json", path, sizeof path);
+    assert_int_equal(check(f, path, &table), 0);
+    assert_int_equal(drift_lines(table, lines, 8), 0);
+    assert_true(row_line(table, "anim/horse/NN ", line));
+    assert_non_null(strstr(line, "absent"));
+    assert_non_null(strstr(line, "present"));
+    assert_non_null(strstr(line, "not in the baseline"));
+    assert_non_null(strstr(table, "3 baseline rows, 4 current rows: 0 drift (0 missing), 1 not in the baseline\n"));
+    free(table);
+    /* The extra row does not hide a drifted one beside it. */
+    edited(f, "cat", "AN", drop_nn_shift_row, "dropped_shifted.json", path, sizeof path);
     assert_int_equal(check(f, path, &table), 1);
     assert_int_equal(drift_lines(table, lines, 8), 1);
-    assert_non_null(strstr(lines[0], "anim/horse/NN "));
-    assert_non_null(strstr(lines[0], "present"));
+    assert_non_null(strstr(lines[0], "anim/cat/AN "));
+    assert_non_null(strstr(table, "1 drift (0 missing), 1 not in the baseline\n"));
     free(table);
-    /* The baseline has a row the run lacks. */
+}
+
+static void test_rows_the_run_lacks_drift(void **state)
+{
+    fixture *f = *state;
+    char *table, lines[8][256];
     char cell[2048];
     tcb_error err = {0};
     assert_int_equal(tcb_cell_path(cell, sizeof cell, f->dir, "anim", "cat", "AN", 0, &err), 0);
@@ -264,7 +301,9 @@ static void test_missing_and_extra_rows_drift(void **state)
     assert_int_equal(check(f, f->baseline, &table), 1);
     assert_int_equal(drift_lines(table, lines, 8), 1);
     assert_non_null(strstr(lines[0], "anim/cat/AN "));
+    assert_non_null(strstr(lines[0], "present"));
     assert_non_null(strstr(lines[0], "missing"));
+    assert_non_null(strstr(table, "4 baseline rows, 3 current rows: 1 drift (1 missing), 0 not in the baseline\n"));
     free(table);
     assert_int_equal(fake_write(f->dir, &CELLS[0]), 0);
 }
@@ -381,7 +420,8 @@ int main(void)
         cmocka_unit_test(test_relative_tolerance),
         cmocka_unit_test(test_row_tolerance),
         cmocka_unit_test(test_null_and_status_mismatch_drift),
-        cmocka_unit_test(test_missing_and_extra_rows_drift),
+        cmocka_unit_test(test_rows_not_in_the_baseline_are_listed_not_judged),
+        cmocka_unit_test(test_rows_the_run_lacks_drift),
         cmocka_unit_test(test_geodesic),
         cmocka_unit_test(test_malformed_baselines),
     };

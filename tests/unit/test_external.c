@@ -4,8 +4,11 @@
  * ignoring SIGTERM killed after its grace, a stop request, a command that
  * cannot be found or run, a tcbench killed outright taking the command
  * with it, the stop signals tcbench blocks unblocked in the child, the
- * environment's additions), the log's tail in a message, and
- * the method refusing a transfer it was not told about. */
+ * environment's additions), the log's tail in a message, the program a
+ * step runs (a .py command's interpreter from params.python, else
+ * $TCBENCH_PYTHON, else python3 from PATH; resolved to an absolute path that
+ * every failure names), and the method refusing a transfer it was not told
+ * about. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -61,6 +64,109 @@ static void test_params(void **state)
     create_fails("{\"command\": [\"x\"], \"timeout_s\": -1}", "external.params.timeout_s: -1 is out of range");
     create_fails("{\"command\": [\"x\"], \"grace_s\": \"soon\"}", "external.params.grace_s: expected a number");
     create_fails("{\"command\": [\"x\"], \"timeout\": 5}", "external.params.timeout: unknown key");
+    create_fails("{\"command\": [\"m.py\"], \"python\": \"\"}", "external.params.python: expected a non-empty string");
+    create_fails("{\"command\": [\"m.py\"], \"python\": 3}", "external.params.python: expected a non-empty string");
+    create_fails("{\"command\": [\"python3\", \"m.py\"], \"python\": \"/venv/bin/python\"}",
+                 "external.params.python: runs .py commands, but command[0] 'python3' is not a .py script");
+}
+
+/* The method made from params, with $TCBENCH_PYTHON set to env (NULL: unset). */
+static ext_method *create_with_env(const char *params, const char *env)
+{
+    void *self = NULL;
+    tcb_error err = {0};
+    if (env) setenv(EXT_PYTHON_ENV, env, 1);
+    else unsetenv(EXT_PYTHON_ENV);
+    int rc = tcb_method_external.create(params, &self, &err);
+    unsetenv(EXT_PYTHON_ENV);
+    if (rc) fail_msg("%s", err.msg);
+    return self;
+}
+
+/* The step's argv, joined by spaces, in out[size]. */
+static void joined_argv(const ext_method *m, char *out, size_t size)
+{
+    char **argv = NULL;
+    tcb_error err = {0};
+    assert_int_equal(ext_step_argv(m, "fit", "/w/manifest.json", &argv, &err), TCB_OK);
+    out[0] = '\0';
+    for (int k = 0; argv[k]; k++) snprintf(out + strlen(out), size - strlen(out), "%s%s", k ? " " : "", argv[k]);
+    free(argv);
+}
+
+/* The interpreter of a .py command: params.python, else $TCBENCH_PYTHON, else
+ * python3; a command naming its own program runs as listed. */
+static void test_python_interpreter_precedence(void **state)
+{
+    (void)state;
+    char text[512];
+    ext_method *m = create_with_env("{\"command\": [\"m.py\", \"--x\"], \"python\": \"/p/python\"}", "/e/python");
+    joined_argv(m, text, sizeof text);
+    assert_string_equal(text, "/p/python m.py --x fit /w/manifest.json");
+    assert_string_equal(m->python_from, "external.params.python");
+    tcb_method_external.destroy(m);
+    m = create_with_env("{\"command\": [\"m.py\"]}", "/e/python");
+    joined_argv(m, text, sizeof text);
+    assert_string_equal(text, "/e/python m.py fit /w/manifest.json");
+    assert_string_equal(m->python_from, "TCBENCH_PYTHON");
+    tcb_method_external.destroy(m);
+    m = create_with_env("{\"command\": [\"m.py\"]}", NULL);
+    joined_argv(m, text, sizeof text);
+    assert_string_equal(text, "python3 m.py fit /w/manifest.json");
+    assert_null(m->python_from);
+    tcb_method_external.destroy(m);
+    m = create_with_env("{\"command\": [\"python3\", \"m.py\"]}", "/e/python");
+    joined_argv(m, text, sizeof text);
+    assert_string_equal(text, "python3 m.py fit /w/manifest.json");
+    tcb_method_external.destroy(m);
+}
+
+/* The program resolved as the log and the messages name it: absolute, with
+ * where it came from; one that cannot be found names the key or variable. */
+static void test_program_resolved_and_named(void **state)
+{
+    const char *dir = *state;
+    char tool[TCB_PATH_MAX], path[TCB_PATH_MAX], want[2 * TCB_PATH_MAX], cwd[TCB_PATH_MAX];
+    tu_write_text(dir, "py", "#!/bin/sh\n", tool, sizeof tool);
+    chmod(tool, 0755);
+    tcb_error err = {0};
+    char params[2 * TCB_PATH_MAX];
+    snprintf(params, sizeof params, "{\"command\": [\"m.py\"], \"python\": \"%s\"}", tool);
+    ext_method *m = create_with_env(params, NULL);
+    char *argv[] = {m->python, "m.py", NULL};
+    assert_int_equal(ext_resolve_program(m, argv, path, &err), TCB_OK);
+    assert_string_equal(path, tool);
+    snprintf(want, sizeof want, "%s [external.params.python]", tool);
+    assert_string_equal(m->program, want);
+    /* Every failure after the run names it; an interrupt or no reconstructions do not. */
+    tcb_fail(&err, TCB_ERR_INPUT, "pred/0.npy: not a .npy file");
+    assert_int_equal(ext_name_program(m, TCB_ERR_INPUT, &err), TCB_ERR_INPUT);
+    snprintf(want, sizeof want, "pred/0.npy: not a .npy file; program: %s [external.params.python]", tool);
+    assert_string_equal(err.msg, want);
+    tcb_fail(&err, TCB_ERR_UNSUPPORTED, "no reconstructions");
+    assert_int_equal(ext_name_program(m, TCB_ERR_UNSUPPORTED, &err), TCB_ERR_UNSUPPORTED);
+    assert_string_equal(err.msg, "no reconstructions");
+    tcb_method_external.destroy(m);
+    /* From PATH, a relative PATH entry included: absolute all the same. */
+    assert_non_null(getcwd(cwd, sizeof cwd));
+    char *old_path = getenv("PATH") ? strdup(getenv("PATH")) : NULL;
+    assert_int_equal(chdir(dir), 0);
+    setenv("PATH", ".", 1);
+    m = create_with_env("{\"command\": [\"m.py\"]}", "py");
+    char *by_name[] = {"py", "m.py", NULL};
+    int rc = ext_resolve_program(m, by_name, path, &err);
+    setenv("PATH", "/nonexistent-tcb", 1);
+    int rc_missing = ext_resolve_program(m, by_name, want, &err);
+    if (old_path) setenv("PATH", old_path, 1);
+    free(old_path);
+    assert_int_equal(chdir(cwd), 0);
+    assert_int_equal(rc, TCB_OK);
+    assert_string_equal(path, tool);
+    snprintf(want, sizeof want, "%s [TCBENCH_PYTHON, py from PATH]", tool);
+    assert_string_equal(m->program, want);
+    assert_int_equal(rc_missing, TCB_ERR_INPUT);
+    expect_text(err.msg, "TCBENCH_PYTHON (the interpreter of m.py): 'py': not found in PATH (/nonexistent-tcb)");
+    tcb_method_external.destroy(m);
 }
 
 /* Runs `sh -c SCRIPT` with its output in dir/log. */
@@ -70,7 +176,7 @@ static int run_sh(const char *dir, const char *script, double timeout_s, double 
     char log[TCB_PATH_MAX];
     snprintf(log, sizeof log, "%s/log", dir);
     char *argv[] = {"sh", "-c", (char *)script, NULL};
-    ext_proc_spec s = {argv, NULL, log, timeout_s, grace_s, NULL, NULL};
+    ext_proc_spec s = {argv, NULL, log, timeout_s, grace_s, NULL, NULL, NULL};
     return ext_proc_run(&s, r, err);
 }
 
@@ -176,7 +282,7 @@ static void test_stop_request(void **state)
     char log[TCB_PATH_MAX];
     snprintf(log, sizeof log, "%s/log", (const char *)*state);
     char *argv[] = {"sleep", "30", NULL};
-    ext_proc_spec s = {argv, NULL, log, 0, 10, stop_now, NULL};
+    ext_proc_spec s = {argv, NULL, log, 0, 10, stop_now, NULL, NULL};
     ext_proc_result r;
     tcb_error err = {0};
     assert_int_equal(ext_proc_run(&s, &r, &err), TCB_OK);
@@ -189,7 +295,7 @@ static void run_fails(const char *dir, char *program, const char *text)
     char log[TCB_PATH_MAX];
     snprintf(log, sizeof log, "%s/log", dir);
     char *argv[] = {program, NULL};
-    ext_proc_spec s = {argv, NULL, log, 0, 1, NULL, NULL};
+    ext_proc_spec s = {argv, NULL, log, 0, 1, NULL, NULL, NULL};
     ext_proc_result r;
     tcb_error err = {0};
     assert_int_equal(ext_proc_run(&s, &r, &err), TCB_ERR_INPUT);
@@ -237,7 +343,7 @@ static void test_environment_additions(void **state)
     setenv("TCB_TEST_KEPT", "kept", 1);
     char *argv[] = {"sh", "-c", "env | grep '^TCB_TEST_' | sort", NULL};
     char *set[] = {"TCB_TEST_VAR=child", "TCB_TEST_NEW=new", NULL};
-    ext_proc_spec s = {argv, set, log, 0, 1, NULL, NULL};
+    ext_proc_spec s = {argv, set, log, 0, 1, NULL, NULL, NULL};
     ext_proc_result r;
     tcb_error err = {0};
     assert_int_equal(ext_proc_run(&s, &r, &err), TCB_OK);
@@ -280,6 +386,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_params),
+        cmocka_unit_test(test_python_interpreter_precedence),
+        cmocka_unit_test_setup_teardown(test_program_resolved_and_named, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test_setup_teardown(test_exit_status_and_output, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test_setup_teardown(test_timeout_ends_the_group, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test_setup_teardown(test_stop_request, tu_setup_tmpdir, tu_teardown_tmpdir),
