@@ -340,8 +340,9 @@ static int grow_record(const claim *c, char **text, tcb_error *err)
     return rc;
 }
 
-/* Writes `text` and a newline to `path` through a temporary. */
-static int write_record(const char *path, const char *text, tcb_error *err)
+/* Writes `text` and a newline to `path` through a temporary; errors name
+ * `shown` (a temporary's name alone says little). */
+static int write_record(const char *path, const char *shown, const char *text, tcb_error *err)
 {
     size_t len = strlen(text);
     char *line = malloc(len + 2);
@@ -350,7 +351,7 @@ static int write_record(const char *path, const char *text, tcb_error *err)
     memcpy(line + len, "\n", 2);
     int rc = tcb_write_file_atomic(path, line, len + 1, err);
     free(line);
-    if (rc) tcb_error_prefix(err, "%s: cannot be written: ", path); /* a temporary's name alone says little */
+    if (rc) tcb_error_prefix(err, "%s: cannot be written: ", shown);
     return rc;
 }
 
@@ -364,7 +365,7 @@ static int claim_dir(const claim *c, const char *run_dir, tcb_error *err)
     int rc = tcb_path_join(mine, sizeof mine, err, "%s.tmp-%ld-claim", c->path, (long)getpid());
     if (rc) return rc;
     tcb_remove_stale_temps(run_dir, "config.json.tmp-");
-    rc = write_record(mine, c->cfg->json_text, err);
+    rc = write_record(mine, c->path, c->cfg->json_text, err);
     if (rc) return rc;
     if (link(mine, c->path) == 0) return unlink(mine), TCB_OK;
     unlink(mine);
@@ -374,7 +375,7 @@ static int claim_dir(const claim *c, const char *run_dir, tcb_error *err)
         rc = tcb_fail(err, TCB_ERR_IO, "%s: cannot lock: %s", run_dir, strerror(errno));
     char *text = NULL;
     if (!rc) rc = grow_record(c, &text, err);
-    if (!rc) rc = write_record(c->path, text, err);
+    if (!rc) rc = write_record(c->path, c->path, text, err);
     free(text);
     if (dir >= 0) close(dir); /* and the lock with it */
     return rc;
