@@ -32,6 +32,11 @@ char *tcb_config_normalized_json(const tcb_config *c);
  * it is read (harness/config_overlay.c). */
 int tcb_config_apply_opts(cJSON *root, const char *origin, const tcb_config_opts *o, tcb_error *err);
 
+/* Relative paths to code ("plugins", an external method's command) made
+ * absolute against the directory of the config file `origin`; nothing
+ * changes when origin names no file (harness/config_paths.c). */
+int tcb_config_resolve_paths(cJSON *root, const char *origin, tcb_error *err);
+
 /* <run_dir>/config.json, the record of the configs whose cells the
  * directory holds: created with cfg's normalized config when there is
  * none; else compared with cfg, and grown to the union of both (new
