@@ -309,10 +309,11 @@ static int compare_configs(const claim *c, const cJSON *was, const cJSON *now, u
     for (const cJSON *m = item(y, "methods")->child; m && !rc; m = m->next, k++) {
         if (!method_difference(named(item(x, "methods"), name_of(m)), m, where, sizeof where, a, b, sizeof a))
             continue;
-        /* --force recomputes what it selects; the record keeps the rest. */
-        int forced = c->opts->force && tcb_run_selected(c->opts, &c->cfg->methods[k]);
+        /* --force recomputes what it selects; the record keeps the rest,
+         * and a method this run does not select is not its to refuse. */
+        int selected = tcb_run_selected(c->opts, &c->cfg->methods[k]), forced = c->opts->force && selected;
         keep_was[k] = !forced;
-        if (!c->for_score && !forced) refuse_method(c, k, where, a, b);
+        if (!c->for_score && selected && !forced) refuse_method(c, k, where, a, b);
     }
     cJSON_Delete(x), cJSON_Delete(y);
     finish_refusal(c);
