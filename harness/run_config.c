@@ -112,6 +112,14 @@ static const char *name_of(const cJSON *o)
 
 static cJSON *item(const cJSON *o, const char *key) { return cJSON_GetObjectItemCaseSensitive(o, key); }
 
+/* The first element of the array o[key]; NULL when there is none (a
+ * record edited by hand may lack what a normalized config has). */
+static cJSON *first(const cJSON *o, const char *key)
+{
+    const cJSON *a = item(o, key);
+    return cJSON_IsArray(a) ? a->child : NULL;
+}
+
 /* first_difference of `was` and `now` less `keys`, under `prefix`. */
 static int difference_without(const cJSON *was, const cJSON *now, const char *const *keys, const char *prefix,
                               char *where, size_t size, char *a, char *b, size_t vsize)
@@ -133,13 +141,13 @@ static int shared_difference(const cJSON *was, const cJSON *now, char *where, si
     static const char *const grown[] = {"seeds", "datasets", "methods", NULL};
     static const char *const sequences[] = {"sequences", NULL}, *const no_keys[] = {NULL};
     if (difference_without(was, now, grown, "", where, size, a, b, vsize)) return 1;
-    for (const cJSON *d = item(now, "datasets")->child; d; d = d->next) {
+    for (const cJSON *d = first(now, "datasets"); d; d = d->next) {
         const cJSON *w = named(item(was, "datasets"), name_of(d));
         if (!w) continue;
         char prefix[160];
         snprintf(prefix, sizeof prefix, "datasets[%s]", name_of(d));
         if (difference_without(w, d, sequences, prefix, where, size, a, b, vsize)) return 1;
-        for (const cJSON *s = item(d, "sequences")->child; s; s = s->next) {
+        for (const cJSON *s = first(d, "sequences"); s; s = s->next) {
             const cJSON *ws = named(item(w, "sequences"), name_of(s));
             char at[400];
             snprintf(at, sizeof at, "%s.sequences[%s]", prefix, name_of(s));
@@ -165,6 +173,7 @@ static int method_difference(const cJSON *was, const cJSON *now, char *where, si
 /* Appends to the array `into` the elements of `from` it lacks. */
 static void add_missing(cJSON *into, const cJSON *from)
 {
+    if (!cJSON_IsArray(into)) return;
     for (const cJSON *e = cJSON_IsArray(from) ? from->child : NULL; e; e = e->next) {
         const cJSON *have = into->child;
         while (have && !cJSON_Compare(have, e, 1)) have = have->next;
@@ -190,6 +199,7 @@ static void merge_dataset(cJSON *into, const cJSON *from)
 
 static void replace_item(cJSON *o, const char *key, cJSON *value)
 {
+    if (!value) return;
     cJSON_DeleteItemFromObjectCaseSensitive(o, key);
     cJSON_AddItemToObject(o, key, value);
 }
@@ -224,7 +234,7 @@ static cJSON *config_union(const cJSON *was, const cJSON *now, const unsigned ch
         if (w && (!item(w, "datasets") || !item(m, "datasets"))) cJSON_DeleteItemFromObjectCaseSensitive(m, "datasets");
         else if (w) add_missing(item(m, "datasets"), item(w, "datasets"));
     }
-    for (const cJSON *w = item(was, "methods")->child; w; w = w->next)
+    for (const cJSON *w = first(was, "methods"); w; w = w->next)
         if (!named(methods, name_of(w))) {
             cJSON *m = cJSON_Duplicate(w, 1);
             replace_item(m, "seeds", method_seeds(w, was));
@@ -306,7 +316,7 @@ static int compare_configs(const claim *c, const cJSON *was, const cJSON *now, u
     cell_settings(x), cell_settings(y);
     int rc = shared_difference(x, y, where, sizeof where, a, b, sizeof a) ? refuse_all(c, where, a, b, err) : TCB_OK;
     int k = 0;
-    for (const cJSON *m = item(y, "methods")->child; m && !rc; m = m->next, k++) {
+    for (const cJSON *m = first(y, "methods"); m && !rc; m = m->next, k++) {
         if (!method_difference(named(item(x, "methods"), name_of(m)), m, where, sizeof where, a, b, sizeof a))
             continue;
         /* --force recomputes what it selects; the record keeps the rest,
