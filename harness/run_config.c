@@ -164,10 +164,10 @@ static int shared_difference(const cJSON *was, const cJSON *now, char *where, si
 static int method_difference(const cJSON *was, const cJSON *now, char *where, size_t size, char *a, char *b,
                              size_t vsize)
 {
-    static const char *const free[] = {"seeds", "datasets", NULL};
+    static const char *const unshared[] = {"seeds", "datasets", NULL};
     char prefix[160];
     snprintf(prefix, sizeof prefix, "methods[%s]", name_of(now));
-    return was && difference_without(was, now, free, prefix, where, size, a, b, vsize);
+    return was && difference_without(was, now, unshared, prefix, where, size, a, b, vsize);
 }
 
 /* Appends to the array `into` the elements of `from` it lacks. */

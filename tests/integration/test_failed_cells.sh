@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Failures are failures (issue 26): a cell that could not be computed (an
-# external method that crashes) is "failed", a diverged training is a
-# result ("diverged"). `tcbench run` exits 1 when a cell of this run failed
+# external method that crashes, added to an existing run directory with no
+# flag) is "failed", a diverged training is a result ("diverged"). `tcbench run` exits 1 when a cell of this run failed
 # and lists the failed cells with their messages (the command's last log
 # line among them) at the end; `status` lists them and counts them apart
 # from diverged ones; a rerun, once the method is fixed, computes only the
@@ -32,8 +32,18 @@ cat > grid.json <<JSON
                  "params": { "command": ["$py", "$fake", "diverge"] }, "seeds": [0] } ] }
 JSON
 
+# The grid without the researcher's method first: a diverged cell is a
+# result, the run exits 0.
+/usr/bin/python3 - <<'PY'
+import json
+c = json.load(open("grid.json"))
+c["methods"] = [m for m in c["methods"] if m["name"] != "mine"]
+json.dump(c, open("base.json", "w"))
+PY
+expect 0 "cells: 3 in all, 3 computed, 0 already done, 0 failed, 1 diverged" "$TCBENCH" run base.json --quiet
+# The method added to the same directory, no --force: it crashes.
 method fail
-expect 1 "cells: 5 in all, 5 computed, 0 already done, 2 failed, 1 diverged" "$TCBENCH" run grid.json --quiet
+expect 1 "cells: 5 in all, 2 computed, 3 already done, 2 failed" "$TCBENCH" run grid.json --quiet
 # The list at the end: each failed cell with its message, the log's last line in it.
 grep -qxF "failed cells (no result; a rerun retries them):" err.txt || { cat err.txt; exit 1; }
 for s in 0 1; do
