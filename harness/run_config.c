@@ -297,12 +297,18 @@ static void finish_refusal(const claim *c)
         }
     char what[TCB_ERRMSG_MAX];
     snprintf(what, sizeof what, "%s", r->msg);
-    tcb_fail(r, TCB_ERR_INPUT,
-             "%s: the run directory holds %s's cells with other settings (%s), so this run left %s alone; "
-             "recompute %s here with 'tcbench run %s --force --only %s'%s, or give the changed method a new "
-             "label",
-             c->path, labels, what, n == 1 ? "them" : "these methods' cells", n == 1 ? "them" : "each",
-             c->cfg->path, n == 1 ? labels : "LABEL", n == 1 ? "" : " for each LABEL");
+    if (n == 1)
+        tcb_fail(r, TCB_ERR_INPUT,
+                 "%s: the run directory holds %s's cells with other settings (%s), so this run left them alone; "
+                 "recompute them here with 'tcbench run %s --force --only %s', or give the changed method a new "
+                 "label",
+                 c->path, labels, what, c->cfg->path, labels);
+    else
+        tcb_fail(r, TCB_ERR_INPUT,
+                 "%s: the run directory holds the cells of %s with other settings (%s), so this run left them "
+                 "alone; recompute them here with 'tcbench run %s --force --only LABEL' for each of %s, or give "
+                 "the changed methods new labels",
+                 c->path, labels, what, c->cfg->path, labels);
 }
 
 /* Compares the record `was` with this run's config `now`: a refusal of
