@@ -519,6 +519,7 @@ int tcb_config_parse_opts(const char *text, const char *origin, const tcb_config
     snprintf(top, sizeof top, "%s:", origin);
     rc = tcb_json_expect_object(root, origin, err);
     if (!rc) rc = tcb_config_apply_opts(root, origin, opts, err);
+    if (!rc) rc = tcb_config_resolve_paths(root, origin, err);
     if (!rc) rc = fix_top(tcb_json_expect_keys(root, top, top_keys, err), origin, err);
     if (!rc) rc = parse_scalars(root, origin, out, err);
     if (!rc) rc = parse_plugins(root, origin, out, err);

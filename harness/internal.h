@@ -32,11 +32,27 @@ char *tcb_config_normalized_json(const tcb_config *c);
  * it is read (harness/config_overlay.c). */
 int tcb_config_apply_opts(cJSON *root, const char *origin, const tcb_config_opts *o, tcb_error *err);
 
-/* <run_dir>/config.json: created with cfg's normalized config when there
- * is none; else compared with cfg on what decides the cells, and refused
- * (TCB_ERR_INPUT, naming both configs and the first difference) when they
- * differ, unless `force`; replaced with cfg's when not refused.
- * (harness/run_config.c) */
+/* Relative paths to code ("plugins", an external method's command) made
+ * absolute against the directory of the config file `origin`; nothing
+ * changes when origin names no file (harness/config_paths.c). */
+int tcb_config_resolve_paths(cJSON *root, const char *origin, tcb_error *err);
+
+/* <run_dir>/config.json, the record of the configs whose cells the
+ * directory holds: created with cfg's normalized config when there is
+ * none; else compared with cfg, and grown to the union of both (new
+ * datasets, sequences, methods, seeds). A difference in a setting every
+ * cell depends on is refused (TCB_ERR_INPUT, naming both configs, the key
+ * path and both values) and nothing is written, unless opts->force, which
+ * takes the directory over for cfg. A method of cfg whose "method" or
+ * "params" differ from those recorded under its label is refused alone:
+ * refused[k] = 1 for it (cfg->methods[k]) and `refusal` says why and how to
+ * recompute it; the record keeps the old one. Under --force the selected
+ * methods take cfg's settings instead. (harness/run_config.c) */
+int tcb_run_dir_claim_methods(const tcb_config *cfg, const char *run_dir, const tcb_run_opts *opts,
+                              unsigned char *refused, tcb_error *refusal, tcb_error *err);
+/* The same for `tcbench score`, whose cell is no config method's: only a
+ * setting every cell depends on is refused (`force`: taken over), with a
+ * hint for score; differing methods keep their record. */
 int tcb_run_dir_claim(const tcb_config *cfg, const char *run_dir, int force, tcb_error *err);
 
 /* Pieces of the runner the dry run shares (harness/runner.c): */

@@ -134,21 +134,32 @@ static int cell_mask(const cli *c, const tcb_config *cfg, unsigned char **mask)
     return fail(&err);
 }
 
+/* The run's counts, and its failed cells with their messages. */
+static void print_counts(const tcb_run_stats *st)
+{
+    fprintf(stderr, "cells: %d in all, %d computed, %d already done, %d failed", st->cells_total, st->cells_done,
+            st->cells_skipped, st->cells_failed);
+    if (st->cells_diverged) fprintf(stderr, ", %d diverged", st->cells_diverged);
+    if (st->cells_busy) fprintf(stderr, ", %d running in other processes", st->cells_busy);
+    fprintf(stderr, "\n");
+    if (st->cells_failed)
+        fprintf(stderr, "failed cells (no result; a rerun retries them):\n%s", st->failures ? st->failures : "");
+}
+
+/* Exit 1 when a cell failed: a table without it is not the run asked for. */
 static int finish_run(const cli *c, const char *run_dir, const tcb_run_stats *st)
 {
     tcb_error err = {0};
-    fprintf(stderr, "cells: %d in all, %d computed, %d already done, %d failed", st->cells_total, st->cells_done,
-            st->cells_skipped, st->cells_failed);
-    if (st->cells_busy) fprintf(stderr, ", %d running in other processes", st->cells_busy);
-    fprintf(stderr, "\n");
+    print_counts(st);
     fprintf(stderr, "results: %s\n", run_dir);
+    int rc = st->cells_failed ? 1 : 0;
     if (!c->set[F_REPORT]) {
         fprintf(stderr, "make the report: tcbench report %s\n", run_dir);
-        return 0;
+        return rc;
     }
     if (tcb_report_write(run_dir, NULL, c->set[F_QUIET] ? NULL : stdout, &err)) return fail(&err);
     fprintf(stderr, "report: %s/report/\n", run_dir);
-    return 0;
+    return rc;
 }
 
 static int cmd_run(const cli *c)
@@ -178,7 +189,7 @@ static int cmd_run(const cli *c)
                          .interrupted = tcb_stop_signals_requested, .interrupt_arg = &stop};
     /* Before any thread exists, so that every thread blocks the signals. */
     if (tcb_stop_signals_start(&stop)) fprintf(stderr, "tcbench: cannot watch for SIGTERM; a signal kills the run\n");
-    tcb_run_stats st;
+    tcb_run_stats st = {0};
     rc = c->set[F_DRY_RUN] ? tcb_run_dry(&cfg, &opts, stdout, &err) : tcb_run(&cfg, &opts, &st, &err);
     tcb_term_progress_finish(&tp);
     char run_dir[TCB_PATH_MAX];
@@ -186,8 +197,11 @@ static int cmd_run(const cli *c)
     tcb_config_free(&cfg);
     free(mask);
     tcb_stop_signals_end(&stop);
-    if (rc) return fail(&err);
-    return c->set[F_DRY_RUN] ? 0 : finish_run(c, run_dir, &st);
+    if (rc && st.refused) print_counts(&st); /* the other methods ran */
+    if (!rc && !c->set[F_DRY_RUN]) rc = finish_run(c, run_dir, &st);
+    else if (rc) rc = fail(&err);
+    tcb_run_stats_free(&st);
+    return rc;
 }
 
 /* `tcbench status RUN_DIR|CONFIG`: a run directory is read through the

@@ -141,7 +141,7 @@ static int plan_cell(void *ctx, const tcb_grid_cell *c)
     estimate_cell(c->method, &w->q, &e);
     char state[TCB_PATH_MAX];
     cell_state(w->run_dir, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state);
-    int runs = w->opts->force || !strcmp(state, "missing") || !strcmp(state, "unreadable");
+    int runs = w->opts->force || !strcmp(state, "missing") || !strcmp(state, "unreadable") || !strcmp(state, "failed");
     char fit[32], eval[32];
     duration_text(e.fit_s, fit, sizeof fit);
     duration_text(e.eval_s, eval, sizeof eval);
@@ -206,9 +206,9 @@ int tcb_run_list_cells(const tcb_config *cfg, const tcb_run_opts *opts, FILE *ou
 typedef struct status_walk {
     FILE *out;
     const char *run_dir;
-    int n_done, n_failed, n_running, n_missing;
-    int range_lo, range_hi;    /* the missing ids' current run, -1: none */
-    char array[4096];          /* the missing ids as Slurm's --array list */
+    int n_done, n_diverged, n_failed, n_running, n_missing;
+    int range_lo, range_hi;    /* the current run of ids to resubmit, -1: none */
+    char array[4096];          /* the ids a run would compute (missing, failed) as Slurm's --array list */
     char failures[8192];
 } status_walk;
 
@@ -222,26 +222,29 @@ static void flush_range(status_walk *w)
     w->range_lo = w->range_hi = -1;
 }
 
+/* A diverged cell is a result (listed, with why); a failed one has none
+ * and is computed again by the next run, as a missing one is. */
 static int status_cell(void *ctx, const tcb_grid_cell *c)
 {
     status_walk *w = ctx;
     char state[TCB_PATH_MAX], msg[TCB_ERRMSG_MAX];
     cell_state_message(w->run_dir, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state, msg,
                        sizeof msg);
-    int missing = !strcmp(state, "missing") || !strcmp(state, "unreadable");
+    int missing = !strcmp(state, "missing") || !strcmp(state, "unreadable"), failed = !strcmp(state, "failed");
     if (!strcmp(state, "done")) w->n_done++;
     else if (!strncmp(state, "running", 7)) {
         w->n_running++;
         fprintf(w->out, "running  %5d  %s/%s/%s seed %d: %s\n", c->id, c->dataset->name, c->sequence->name,
                 c->method->label, c->seed, state + 8);
     } else if (!missing) {
-        w->n_failed++;
+        w->n_failed += failed;
+        w->n_diverged += !failed;
         size_t used = strlen(w->failures);
         snprintf(w->failures + used, sizeof w->failures - used, "%-8s %5d  %s/%s/%s seed %d: %s\n", state, c->id,
                  c->dataset->name, c->sequence->name, c->method->label, c->seed, msg);
     }
-    if (missing) {
-        w->n_missing++;
+    w->n_missing += missing;
+    if (missing || failed) {
         if (w->range_hi >= 0 && c->id == w->range_hi + 1) w->range_hi = c->id;
         else flush_range(w), w->range_lo = w->range_hi = c->id;
     }
@@ -255,8 +258,10 @@ int tcb_run_status(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, t
     tcb_grid_for_each(cfg, status_cell, &w);
     flush_range(&w);
     fputs(w.failures, out);
-    fprintf(out, "%s: %d cells: %d done, %d failed or diverged, %d running, %d missing\n", w.run_dir,
-            tcb_grid_count(cfg), w.n_done, w.n_failed, w.n_running, w.n_missing);
-    if (w.n_missing) fprintf(out, "resubmit the missing cells: --array=%s\n", w.array);
+    fprintf(out, "%s: %d cells: %d done, %d diverged, %d failed, %d running, %d missing\n", w.run_dir,
+            tcb_grid_count(cfg), w.n_done, w.n_diverged, w.n_failed, w.n_running, w.n_missing);
+    if (w.n_missing || w.n_failed)
+        fprintf(out, "resubmit the cells a run computes (%d missing, %d failed): --array=%s\n", w.n_missing,
+                w.n_failed, w.array);
     return TCB_OK;
 }

@@ -24,6 +24,7 @@ typedef struct run_state {
     const char *run_dir;
     char git_revision[64];
     tcb_run_stats *stats;
+    const unsigned char *refused; /* [n_methods] 1: the run directory refused the method (run_config.c) */
 } run_state;
 
 /* Unlinks "<path>.tmp-*" left by a writer killed before its rename: a
@@ -173,11 +174,13 @@ int tcb_harness_work_paths(const char *run_dir, const char *dataset, const char 
     return rc;
 }
 
-/* An existing cell is reused only if it was made with the same method,
- * params and split; otherwise the results directory would mix settings.
+/* An existing result (ok or diverged: a diverged training is the method's
+ * result) is kept only if it was made with the same method, params and
+ * split; otherwise the results directory would mix settings. A failed cell
+ * (a crash, a time-out, bad output: no result) is computed again, *keep 0.
  * (The split's path is not compared: the same split may be reached through
  * another working directory.) */
-static int check_existing(const char *path, const tcb_method_spec *m, const tcb_split *split,
+static int check_existing(const char *path, const tcb_method_spec *m, const tcb_split *split, int *keep,
                           tcb_error *err)
 {
     tcb_cell_result c;
@@ -186,12 +189,14 @@ static int check_existing(const char *path, const tcb_method_spec *m, const tcb_
         tcb_error_prefix(err, "cannot resume (rerun with --force to recompute): ");
         return rc;
     }
-    const char *what = strcmp(c.method_impl, m->method) != 0     ? "method"
+    const char *what = c.status == TCB_CELL_FAILED                   ? NULL
+                       : strcmp(c.method_impl, m->method) != 0     ? "method"
                        : strcmp(c.params_json, m->params_json) != 0 ? "params"
                        : c.split_seed != split->seed               ? "split seed"
                        : c.status == TCB_CELL_OK && c.n_pairs != split->n_pairs
                            ? "number of pairs"
                            : NULL;
+    *keep = c.status != TCB_CELL_FAILED;
     tcb_cell_free(&c);
     if (!what) return TCB_OK;
     return tcb_fail(err, TCB_ERR_INPUT,
@@ -208,6 +213,18 @@ typedef struct seq_ctx {
     const char *split_path;
     double load_s;
 } seq_ctx;
+
+/* A failed cell of this run, "LABEL: MESSAGE" in the run's list of them. */
+static int note_failure(tcb_run_stats *stats, const char *label, const char *message, tcb_error *err)
+{
+    size_t used = stats->failures ? strlen(stats->failures) : 0, add = strlen(label) + strlen(message) + 4;
+    char *grown = realloc(stats->failures, used + add);
+    if (!grown) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
+    snprintf(grown + used, add, "%s: %s\n", label, message);
+    stats->failures = grown;
+    stats->cells_failed++;
+    return TCB_OK;
+}
 
 static int run_cell(const run_state *st, const seq_ctx *sc, const tcb_method_spec *m, int seed,
                     const char *cell_path, tcb_error *err)
@@ -246,38 +263,44 @@ static int run_cell(const run_state *st, const seq_ctx *sc, const tcb_method_spe
         return rc;
     }
     rc = tcb_cell_save(cell_path, &cell, err);
-    if (!rc && cell.status != TCB_CELL_OK) {
-        st->stats->cells_failed++;
+    if (!rc && cell.status != TCB_CELL_OK)
         tcb_report_log(&st->opts->reporter, TCB_LOG_WARN, "%s %s: %s", label,
                        tcb_cell_status_name(cell.status), cell.message);
-    }
+    if (!rc && cell.status == TCB_CELL_FAILED) rc = note_failure(st->stats, label, cell.message, err);
     if (!rc) st->stats->cells_done++;
+    if (!rc) st->stats->cells_diverged += cell.status == TCB_CELL_DIVERGED;
     tcb_cell_free(&cell);
     return rc;
 }
 
-static int skip_finished(const run_state *st, const tcb_method_spec *m, const seq_ctx *sc, const char *path,
-                         tcb_error *err)
+/* *keep: the cell file at `path` holds a result this run keeps (counted
+ * as already done); 0 when there is none or it failed. */
+static int kept_result(const run_state *st, const tcb_method_spec *m, const seq_ctx *sc, const char *path, int *keep,
+                       tcb_error *err)
 {
-    int rc = check_existing(path, m, sc->split, err);
-    if (!rc) st->stats->cells_skipped++;
+    *keep = 0;
+    if (st->opts->force || !tcb_is_file(path)) return TCB_OK;
+    int rc = check_existing(path, m, sc->split, keep, err);
+    if (!rc && *keep) st->stats->cells_skipped++;
     return rc;
 }
 
-/* A finished cell is skipped; any other is computed under its lock, unless
- * another live process holds that (it is then left to it). The lock is
- * taken before a look at the cell file settles anything, since the holder
- * may finish it meanwhile. */
+/* A finished cell is skipped; any other (a failed one too) is computed
+ * under its lock, unless another live process holds that (it is then left
+ * to it). The lock is taken before a look at the cell file settles
+ * anything, since the holder may finish it meanwhile. */
 static int claim_and_run(const run_state *st, const seq_ctx *sc, const tcb_method_spec *m, int seed,
                          const char *path, tcb_error *err)
 {
-    if (!st->opts->force && tcb_is_file(path)) return skip_finished(st, m, sc, path, err);
+    int keep;
+    int rc = kept_result(st, m, sc, path, &keep, err);
+    if (rc || keep) return rc;
     tcb_cell_lock lock;
     tcb_lock_info holder;
     char note[512], label[TCB_CELL_LABEL_MAX];
     double timeout = st->opts->lock_timeout_s > 0 ? st->opts->lock_timeout_s : TCB_LOCK_TIMEOUT_DEFAULT_S;
     tcb_cell_label(label, sizeof label, sc->dataset->name, sc->seq->name, m->label, seed);
-    int rc = tcb_cell_lock_acquire(&lock, path, timeout, &holder, note, sizeof note, err);
+    rc = tcb_cell_lock_acquire(&lock, path, timeout, &holder, note, sizeof note, err);
     if (rc) return rc;
     if (!lock.held) {
         st->stats->cells_busy++;
@@ -286,16 +309,18 @@ static int claim_and_run(const run_state *st, const seq_ctx *sc, const tcb_metho
         return TCB_OK;
     }
     if (note[0]) tcb_report_log(&st->opts->reporter, TCB_LOG_WARN, "%s: %s", label, note);
-    rc = !st->opts->force && tcb_is_file(path) ? skip_finished(st, m, sc, path, err)
-                                                : run_cell(st, sc, m, seed, path, err);
+    rc = kept_result(st, m, sc, path, &keep, err);
+    if (!rc && !keep) rc = run_cell(st, sc, m, seed, path, err);
     tcb_cell_lock_release(&lock);
     return rc;
 }
 
-/* The cell with this id and method is one the options ask for. */
-static int cell_wanted(const tcb_run_opts *opts, int id, const tcb_method_spec *m)
+/* The cell with this id and method is one the options ask for, of a
+ * method the run directory accepts. */
+static int cell_wanted(const run_state *st, int id, const tcb_method_spec *m)
 {
-    return tcb_run_selected(opts, m) && (!opts->cells || opts->cells[id]);
+    const tcb_run_opts *opts = st->opts;
+    return !st->refused[m - st->cfg->methods] && tcb_run_selected(opts, m) && (!opts->cells || opts->cells[id]);
 }
 
 /* Whether any cell of the sequence whose cells start at `first` is wanted:
@@ -307,7 +332,7 @@ static int sequence_wanted(const run_state *st, const tcb_dataset_spec *d, int f
         const tcb_method_spec *m = &st->cfg->methods[k];
         if (!tcb_method_runs_on(m, d->name)) continue;
         for (int s = 0; s < m->n_seeds; s++, id++)
-            if (cell_wanted(st->opts, id, m)) return 1;
+            if (cell_wanted(st, id, m)) return 1;
     }
     return 0;
 }
@@ -321,7 +346,7 @@ static int run_cells(const run_state *st, const seq_ctx *sc, int first, tcb_erro
         const tcb_method_spec *m = &cfg->methods[k];
         if (!tcb_method_runs_on(m, sc->dataset->name)) continue;
         for (int s = 0; s < m->n_seeds; s++, id++) {
-            if (!cell_wanted(st->opts, id, m)) continue;
+            if (!cell_wanted(st, id, m)) continue;
             if (st->opts->interrupted && st->opts->interrupted(st->opts->interrupt_arg))
                 return tcb_fail(err, TCB_ERR_INTERRUPTED, "stopped before cell %d", id);
             char path[TCB_PATH_MAX];
@@ -391,17 +416,10 @@ static int check_roots(const tcb_config *cfg, tcb_error *err)
     return TCB_OK;
 }
 
-int tcb_run(const tcb_config *cfg, const tcb_run_opts *opts, tcb_run_stats *stats,
-            tcb_error *err)
+static int run_grid(const run_state *st, tcb_error *err)
 {
-    memset(stats, 0, sizeof *stats);
-    run_state st = {cfg, opts, opts->output ? opts->output : cfg->output, "", stats};
-    int rc = tcb_harness_load_plugins(cfg, err);
-    if (!rc) rc = tcb_run_check_methods(cfg, opts, err);
-    if (!rc) rc = check_roots(cfg, err);
-    if (!rc) rc = tcb_run_dir_claim(cfg, st.run_dir, opts->force, err);
-    if (rc) return rc;
-    tcb_git_revision(st.git_revision, sizeof st.git_revision);
+    const tcb_config *cfg = st->cfg;
+    int rc = TCB_OK;
     for (int k = 0, first = 0; k < cfg->n_datasets && !rc; k++) {
         const tcb_dataset_spec *d = &cfg->datasets[k];
         int per_sequence = tcb_grid_cells_per_sequence(cfg, d);
@@ -409,11 +427,44 @@ int tcb_run(const tcb_config *cfg, const tcb_run_opts *opts, tcb_run_stats *stat
             /* A warning, not info: a silently shorter table would mislead. */
             char why[TCB_PATH_MAX + 64];
             tcb_run_missing_root_text(d, why, sizeof why);
-            tcb_report_log(&opts->reporter, TCB_LOG_WARN, "dataset %s skipped: %s (optional)", d->name, why);
+            tcb_report_log(&st->opts->reporter, TCB_LOG_WARN, "dataset %s skipped: %s (optional)", d->name, why);
         }
         for (int s = 0; s < d->n_sequences && !rc && !tcb_run_root_missing(d); s++)
-            rc = run_sequence(&st, d, &d->sequences[s], first + s * per_sequence, err);
+            rc = run_sequence(st, d, &d->sequences[s], first + s * per_sequence, err);
         first += d->n_sequences * per_sequence;
     }
     return rc;
+}
+
+int tcb_run(const tcb_config *cfg, const tcb_run_opts *opts, tcb_run_stats *stats,
+            tcb_error *err)
+{
+    memset(stats, 0, sizeof *stats);
+    unsigned char *refused = calloc((size_t)cfg->n_methods + 1, 1);
+    if (!refused) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
+    run_state st = {cfg, opts, opts->output ? opts->output : cfg->output, "", stats, refused};
+    tcb_error refusal = {0};
+    int rc = tcb_harness_load_plugins(cfg, err);
+    if (!rc) rc = tcb_run_check_methods(cfg, opts, err);
+    if (!rc) rc = check_roots(cfg, err);
+    if (!rc) rc = tcb_run_dir_claim_methods(cfg, st.run_dir, opts, refused, &refusal, err);
+    /* Said first too, so that the cells it leaves out are not waited for. */
+    if (!rc && refusal.code)
+        tcb_report_log(&opts->reporter, TCB_LOG_WARN, "the run directory refuses some methods (why: at the end); the "
+                       "others run");
+    if (!rc) tcb_git_revision(st.git_revision, sizeof st.git_revision);
+    if (!rc) rc = run_grid(&st, err);
+    free(refused);
+    if (!rc && refusal.code) {
+        *err = refusal;
+        rc = refusal.code;
+        stats->refused = 1;
+    }
+    return rc;
+}
+
+void tcb_run_stats_free(tcb_run_stats *stats)
+{
+    free(stats->failures);
+    stats->failures = NULL;
 }

@@ -1,10 +1,19 @@
 /* tcbench — run configuration (JSON, validated; errors name the key).
  *
+ * Paths to code resolve against the config file's directory (made
+ * absolute when the config is read, harness/config_paths.c): "plugins",
+ * and an external method's "command" elements that name a file beside the
+ * config. Paths to data and results — "output", "splits_dir", "cache_dir",
+ * a dataset's "root" — stay relative to the current directory (the
+ * shipped configs are run from the repository root: "output":
+ * "runs/quick"), as do --out, --root and --plugin on the command line.
+ *
  *   { "name": "quick",
  *     "output": "runs/quick",            run directory (relative to the CWD)
- *     "splits_dir": "splits",            where split files live (written once)
- *     "cache_dir": ".tcbench-cache",     parsed-sequence cache ("" disables)
- *     "plugins": ["path/lib.so"],        optional out-of-tree methods
+ *     "splits_dir": "splits",            where split files live (written once; CWD)
+ *     "cache_dir": ".tcbench-cache",     parsed-sequence cache ("" disables; CWD)
+ *     "plugins": ["path/lib.so"],        optional out-of-tree methods (relative to
+ *                                        the config file's directory)
  *     "seeds": [0],
  *     "threads": 2,
  *     "reference": { "source": "iccv21", "tables": ["5"] },   the paper's tables
@@ -22,7 +31,7 @@
  *         "align_samples": 1000,         vertices the alignment's Chamfer runs on
  *         "sampling": "without_replacement" | "with_replacement",
  *         "optional": false,             skip (with a message) when root is absent
- *         "root": "../shared/data/anim", objdir sources only: <root>/<sequence>/; may be
+ *         "root": "../shared/data/anim", objdir sources only: <root>/<sequence>/ (CWD); may be
  *                                        left out and given as --root NAME=DIR or in the
  *                                        environment as TCBENCH_ROOT_<NAME>
  *         "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] },

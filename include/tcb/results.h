@@ -1,8 +1,9 @@
 /* tcbench — the results store: one JSON file per cell, written atomically.
  *
  * Layout of a run directory:
- *     <run>/config.json                                  the config as run; a run of a
- *         config whose cells would differ is refused (harness/run_config.c)
+ *     <run>/config.json                                  the configs as run: the union of
+ *         their datasets, sequences, methods and seeds; a run that would change cells
+ *         already there is refused (harness/run_config.c)
  *     <run>/cells/<dataset>/<sequence>/<method>/seed_<s>.json
  *     <run>/work/<dataset>/<sequence>/<method>/seed_<s>/  method checkpoints
  *         (model.ckpt after fit, model.ckpt.fit.json its record: the cell
@@ -10,7 +11,10 @@
  *         and a method's own training state while it fits)
  *     <run>/report/                                      written by `tcbench report`
  * A cell file exists only once the cell finished (ok, failed or diverged);
- * `tcbench run` skips cells whose file exists, so a killed run resumes.
+ * `tcbench run` skips cells whose file holds a result (ok, or diverged: a
+ * diverged training is the method's result), so a killed run resumes, and
+ * computes failed cells again (failed: no result — the method crashed,
+ * timed out, wrote bad output or refused its input).
  *
  * Cell file format "tcbench-cell/1" (all metric values in raw units:
  * distances in normalized shape units, rank/auc/pck as fractions):

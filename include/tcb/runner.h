@@ -3,7 +3,8 @@
  * For each cell: load (cached) sequence, obtain its split, create the method,
  * fit, transfer every evaluation pair, project, score, reconstruct when the
  * method can, and write the cell file atomically. Finished cells are skipped,
- * so rerunning a killed run resumes it and yields the same results. A cell
+ * so rerunning a killed run resumes it and yields the same results; failed
+ * cells (no result) are computed again. A cell
  * is computed under its lock (<cell>.json.lock), so any number of processes
  * may run one config on one run directory and each cell is computed once. */
 #ifndef TCB_RUNNER_H
@@ -47,12 +48,24 @@ int tcb_cell_set_parse(const char *spec, int n_cells, unsigned char *mask, tcb_e
 int tcb_shard_parse(const char *spec, int n_cells, unsigned char *mask, tcb_error *err);
 
 typedef struct tcb_run_stats {
-    int cells_total, cells_done, cells_skipped, cells_failed;
+    int cells_total, cells_done, cells_skipped;
+    int cells_diverged;      /* of cells_done: a diverged training is the method's result */
+    int cells_failed;        /* of cells_done: no result (a crash, a time-out, bad output); a rerun retries them */
+    char *failures;          /* malloc'ed: "LABEL: MESSAGE\n" for each failed cell of this run, or NULL */
     int cells_busy;          /* locked by another live process: left to it */
+    int refused;             /* the run directory refused some methods (tcb_run's error says which) */
 } tcb_run_stats;
 
+/* Runs the grid. A failed cell is recorded (status failed) and the run goes
+ * on: it is counted in stats, not returned. A finished cell is skipped,
+ * unless it failed: that one is computed again. When the run directory
+ * refuses some methods' cells (their settings differ from those it holds
+ * under their labels), the others are run and then that refusal is
+ * returned (TCB_ERR_INPUT, stats->refused set). Free stats with
+ * tcb_run_stats_free, whatever is returned. */
 int tcb_run(const tcb_config *cfg, const tcb_run_opts *opts, tcb_run_stats *stats,
             tcb_error *err);
+void tcb_run_stats_free(tcb_run_stats *stats);
 
 /* The sequence `tcbench run` scores the cells of cfg's dataset and
  * sequence (both by name) on: generated or read (through the config's

@@ -20,12 +20,12 @@ while [ $# -gt 0 ]; do
         *) run_args+=("$1"); shift ;;
     esac
 done
-# The status of the config as these options resolve it: its missing ids.
+# The status of the config as these options resolve it: the ids a run computes (missing, failed).
 status_args=()
 for ((k = 0; k < ${#run_args[@]}; k++)); do
     case "${run_args[k]}" in --variant|--root|--out) status_args+=("${run_args[k]}" "${run_args[k + 1]}"); k=$((k + 1)) ;; esac
 done
-array=$("$tcbench" status "$config" "${status_args[@]}" | sed -n 's/^resubmit the missing cells: --array=//p')
+array=$("$tcbench" status "$config" "${status_args[@]}" | sed -n 's/^resubmit the cells a run computes ([^)]*): --array=//p')
 if [ -z "$array" ]; then echo "submit.sh: every cell of $config is done" >&2; exit 0; fi
 export TCBENCH="$tcbench"
 if [ "$tasks" -gt 0 ]; then

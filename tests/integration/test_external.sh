@@ -7,7 +7,8 @@
 # "diverged" status 3, a timeout (a command ignoring SIGTERM killed after
 # its grace), a malformed, a missing prediction, a missing reconstruction
 # and a command that does not exist fail the cell with a message naming
-# the file or the command, and leave none of its processes behind; bad
+# the file or the command (the run exits 1 and lists them, log tails
+# included), and leave none of its processes behind; bad
 # params stop the run before it starts. inspect, frames and a resumed run
 # reuse the fit; --force clears the command's model directory. A stop request
 # (SIGTERM to tcbench) stops the command gracefully in fit and in transfer,
@@ -64,7 +65,14 @@ config ext.json '{ "name": "nearest" }' '{ "name": "oracle" }' \
     "$(fake timeout sleep '"timeout_s": 4')" "$(fake stubborn stubborn '"timeout_s": 4, "grace_s": 0.5')" \
     "$(fake malformed malformed)" "$(fake missing missing)" "$(fake partial_recon partial_recon)" \
     "$(ext nocmd '"tcb-no-such-command"')" "$(ext nofile '"/nonexistent/tcb-cmd"')"
-"$TCBENCH" run ext.json --quiet 2> run.log || { cat run.log; exit 1; }
+# Eight cells fail (no result): the run exits 1 and lists them at the end,
+# the crashed command's last log lines in its message.
+rc=0
+"$TCBENCH" run ext.json --quiet 2> run.log || rc=$?
+[ "$rc" -eq 1 ] && grep -qF "15 computed, 0 already done, 8 failed, 1 diverged" run.log &&
+    sed -n '/^failed cells (no result; a rerun retries them):$/,$p' run.log |
+    grep -qE "^synth/quadruped_walk/fail/seed 0: fit: .*its last lines: line 6 \| .* \| line 15$" ||
+    { echo "FAIL: run with failed cells exited $rc"; cat run.log; exit 1; }
 
 "$py" - <<'PY'
 import json, os

@@ -87,18 +87,18 @@ grep -qF "model.ckpt: not reused (resumed/work/synth/quadruped_trot/slow/seed_1/
     { echo "FAIL: a checkpoint without its record was not refused"; cat unrecorded.log; exit 1; }
 at_least_1000 "$(fit_s "$rcell")" || { echo "FAIL: the refit reports fit_s $(fit_s "$rcell")"; exit 1; }
 
-# Cells made with other settings are not silently mixed in: another config
-# is refused by the run directory, and a cell of other params (left by a
-# --force of another config) by the cell file.
+# Cells made with other settings are not silently mixed in: a method whose
+# params changed is refused by the run directory (the others run), and
+# once --force --only recomputed it, the old config is refused for it.
 sed 's/"noise": 0.01/"noise": 0.02/' grid.json > changed.json
 rc=0
 "$TCBENCH" run changed.json --out killed --quiet 2> changed.log || rc=$?
-[ "$rc" -eq 2 ] && grep -qF "holds the cells of another config than changed.json (methods[2].params.noise: 0.01 there, 0.02 here)" changed.log ||
+[ "$rc" -eq 2 ] && grep -qF "holds slow's cells with other settings (methods[slow].params.noise: 0.01 there, 0.02 here)" changed.log ||
     { echo "FAIL: changed params resumed (exit $rc)"; cat changed.log; exit 1; }
 "$TCBENCH" run changed.json --out killed --quiet --only slow --force
 "$TCBENCH" run grid.json --out killed --quiet --only oracle --force
 rc=0
 "$TCBENCH" run grid.json --out killed --quiet 2> mixed.log || rc=$?
-[ "$rc" -eq 2 ] && grep -qF "was computed with another params" mixed.log ||
+[ "$rc" -eq 2 ] && grep -qF "(methods[slow].params.noise: 0.02 there, 0.01 here)" mixed.log ||
     { echo "FAIL: a cell of other params resumed (exit $rc)"; cat mixed.log; exit 1; }
 echo "resume test passed"
