@@ -131,7 +131,10 @@ static int take_over(const char *path, const char *tmp, const tcb_lock_info *old
     tcb_lock_info now;
     int same = !read_lock(path, &now) && now.pid == old->pid && now.started == old->started &&
                !strcmp(now.host, old->host);
-    int taken = same && !unlink(path) && !link(tmp, path);
+    /* rename replaces the dead holder's file in one step: an unlink and a
+     * link would leave a moment without a lock, in which another process
+     * would claim it as free and this takeover would fail unsaid. */
+    int taken = same && !rename(tmp, path);
     unlink(guard);
     return taken;
 }

@@ -273,6 +273,21 @@ static int run_cell(const run_state *st, const seq_ctx *sc, const tcb_method_spe
     return rc;
 }
 
+/* A finished cell's lock left by a process killed between writing the cell
+ * and releasing the lock: taken over and released (a live holder's is left
+ * alone), so no lock outlives its run. */
+static int clear_stale_lock(const run_state *st, const char *path, tcb_error *err)
+{
+    tcb_lock_info holder;
+    if (tcb_cell_lock_holder(path, &holder)) return TCB_OK;
+    tcb_cell_lock lock;
+    char note[512];
+    double timeout = st->opts->lock_timeout_s > 0 ? st->opts->lock_timeout_s : TCB_LOCK_TIMEOUT_DEFAULT_S;
+    int rc = tcb_cell_lock_acquire(&lock, path, timeout, &holder, note, sizeof note, err);
+    tcb_cell_lock_release(&lock);
+    return rc;
+}
+
 /* *keep: the cell file at `path` holds a result this run keeps (counted
  * as already done); 0 when there is none or it failed. */
 static int kept_result(const run_state *st, const tcb_method_spec *m, const seq_ctx *sc, const char *path, int *keep,
@@ -282,6 +297,7 @@ static int kept_result(const run_state *st, const tcb_method_spec *m, const seq_
     if (st->opts->force || !tcb_is_file(path)) return TCB_OK;
     int rc = check_existing(path, m, sc->split, keep, err);
     if (!rc && *keep) st->stats->cells_skipped++;
+    if (!rc && *keep) rc = clear_stale_lock(st, path, err);
     return rc;
 }
 

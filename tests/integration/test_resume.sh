@@ -53,6 +53,20 @@ leftovers=$(find killed splits -name '*.tmp-*')
 # A finished run skips every cell.
 "$TCBENCH" run grid.json --out killed --quiet 2> rerun.log
 grep -qF "0 computed, $n_cells already done" rerun.log || { cat rerun.log; exit 1; }
+# A process killed between writing its cell and releasing the lock leaves
+# a finished cell with a dead holder's lock: the next run removes it, and a
+# live holder's stays.
+true & dead=$!
+wait "$dead"
+stale=killed/cells/synth/quadruped_walk/nearest/seed_0.json.lock
+live=killed/cells/synth/quadruped_walk/nearest/seed_1.json.lock
+printf '{"host": "%s", "pid": %d, "started": 1.5}\n' "$(hostname)" "$dead" > "$stale"
+printf '{"host": "%s", "pid": %d, "started": 1.5}\n' "$(hostname)" "$$" > "$live"
+"$TCBENCH" run grid.json --out killed --quiet 2> stale.log
+grep -qF "0 computed, $n_cells already done" stale.log || { cat stale.log; exit 1; }
+[ ! -e "$stale" ] || { echo "FAIL: a dead process's lock outlived its finished cell"; exit 1; }
+[ -e "$live" ] || { echo "FAIL: a live holder's lock was removed"; exit 1; }
+rm "$live"
 
 # Evaluation resumed from a checkpoint (then from a corrupt one) matches.
 cell=killed/cells/synth/quadruped_trot/slow/seed_1.json
