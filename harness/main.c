@@ -857,6 +857,11 @@ int main(int argc, char **argv)
 {
     cli c = {0};
     int i = 1, rc;
+    /* Tables on stdout, status lines on stderr: line by line, each stream in
+     * the order written, so that `tcbench report > file 2>&1` never finds a
+     * status line inside a table (a fully buffered stdout reached the file
+     * in 4 KiB blocks, after the stderr lines written meanwhile). */
+    setvbuf(stdout, NULL, _IOLBF, 0);
     /* Global flags (--plugin, --help) may precede the command. */
     for (; i < argc && argv[i][0] == '-'; i++)
         if ((rc = parse_flag(NULL, argc, argv, &i, &c))) return rc;
