@@ -33,8 +33,9 @@ static const int N_DASH_STEPS[] = {0, 2, 2, 4};
 
 int tcb_chart_style_of(const char *label)
 {
+    if (!label) return 0;
     uint32_t h = 2166136261u ^ STYLE_SALT; /* FNV-1a, then murmur3's finalizer: every bit mixes */
-    for (const unsigned char *p = (const unsigned char *)(label ? label : ""); *p; p++) h = (h ^ *p) * 16777619u;
+    for (const unsigned char *p = (const unsigned char *)label; *p; p++) h = (h ^ *p) * 16777619u;
     h ^= h >> 16, h *= 0x85ebca6bu, h ^= h >> 13, h *= 0xc2b2ae35u, h ^= h >> 16;
     return (int)(h % (N_COLOURS * N_DASHES));
 }

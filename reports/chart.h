@@ -42,7 +42,8 @@ double tcb_chart_py(const tcb_chart *c, double y);
  * a method keeps its colour in every plot of every report whatever rows
  * are added or removed. The price of that: two labels can share a colour
  * (then most often not the dash); the salt is chosen so that the labels of
- * each shipped config do not. */
+ * each shipped config do not. NULL (a plot of one series): 0, the first
+ * colour, solid. */
 int tcb_chart_style_of(const char *label);
 
 /* Clip to the plot area and take the label's colour, width and dash. */
