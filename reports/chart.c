@@ -92,50 +92,29 @@ static void tick_label(const tcb_chart_axis *a, double v, char *out, size_t size
     else snprintf(out, size, a->format, v);
 }
 
-static void grid_line(cairo_t *cr, double x0, double y0, double x1, double y1, int labelled)
-{
-    double g = labelled ? 0.90 : 0.95;
-    cairo_set_source_rgb(cr, g, g, g);
-    cairo_move_to(cr, x0, y0);
-    cairo_line_to(cr, x1, y1);
-    cairo_stroke(cr);
-}
-
-static void draw_x_ticks(tcb_chart *c)
+/* The grid line, tick mark and label of each tick of the x axis (y: 0)
+ * or the y axis (1). */
+static void draw_ticks(tcb_chart *c, int y_axis)
 {
     cairo_t *cr = c->cr;
+    const tcb_chart_axis *a = y_axis ? &c->y : &c->x;
     double v[MAX_TICKS];
-    int labelled[MAX_TICKS], n = axis_ticks(&c->x, v, labelled);
+    int labelled[MAX_TICKS], n = axis_ticks(a, v, labelled);
     for (int k = 0; k < n; k++) {
-        double x = round(tcb_chart_px(c, v[k])) + 0.5;
-        grid_line(cr, x, Y0, x, Y1, labelled[k]);
+        double at = round(y_axis ? tcb_chart_py(c, v[k]) : tcb_chart_px(c, v[k])) + 0.5, g = labelled[k] ? 0.90 : 0.95;
+        cairo_set_source_rgb(cr, g, g, g);
+        cairo_move_to(cr, y_axis ? X0 : at, y_axis ? at : Y0);
+        cairo_line_to(cr, y_axis ? X1 : at, y_axis ? at : Y1);
+        cairo_stroke(cr);
         if (!labelled[k]) continue;
         char label[32];
         cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
-        cairo_move_to(cr, x, Y1);
-        cairo_line_to(cr, x, Y1 + 6);
+        cairo_move_to(cr, y_axis ? X0 - 6 : at, y_axis ? at : Y1);
+        cairo_line_to(cr, y_axis ? X0 : at, y_axis ? at : Y1 + 6);
         cairo_stroke(cr);
-        tick_label(&c->x, v[k], label, sizeof label);
-        text(cr, x, Y1 + 24, 0.5, label);
-    }
-}
-
-static void draw_y_ticks(tcb_chart *c)
-{
-    cairo_t *cr = c->cr;
-    double v[MAX_TICKS];
-    int labelled[MAX_TICKS], n = axis_ticks(&c->y, v, labelled);
-    for (int k = 0; k < n; k++) {
-        double y = round(tcb_chart_py(c, v[k])) + 0.5;
-        grid_line(cr, X0, y, X1, y, labelled[k]);
-        if (!labelled[k]) continue;
-        char label[32];
-        cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
-        cairo_move_to(cr, X0 - 6, y);
-        cairo_line_to(cr, X0, y);
-        cairo_stroke(cr);
-        tick_label(&c->y, v[k], label, sizeof label);
-        text(cr, X0 - 10, y + 5, 1, label);
+        tick_label(a, v[k], label, sizeof label);
+        if (y_axis) text(cr, X0 - 10, at + 5, 1, label);
+        else text(cr, at, Y1 + 24, 0.5, label);
     }
 }
 
@@ -149,8 +128,8 @@ void tcb_chart_begin(tcb_chart *c, const tcb_chart_axis *x, const tcb_chart_axis
     cairo_paint(cr);
     cairo_set_line_width(cr, 1);
     font(cr, 13, 0);
-    draw_x_ticks(c);
-    draw_y_ticks(c);
+    draw_ticks(c, 0);
+    draw_ticks(c, 1);
     cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
     cairo_rectangle(cr, X0 + 0.5, Y0 + 0.5, X1 - X0 - 1, Y1 - Y0 - 1);
     cairo_stroke(cr);
