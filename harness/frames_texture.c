@@ -134,20 +134,51 @@ static void face_colors(const tcb_uv_mesh *m, const tcb_checker *c, uint8_t *rgb
     }
 }
 
+/* n_collapsed[k]: the collapsed patches of frame k's surface; said on
+ * stderr (a warning, also under --quiet) in one line for all frames. */
+static int collapsed_patches(const tcb_frames_job *f, const tcb_uv_mesh *mesh, int *n_collapsed, tcb_error *err)
+{
+    unsigned char flags[MAX_CHARTS];
+    char msg[1024];
+    int any = 0;
+    size_t used = (size_t)snprintf(msg, sizeof msg, "%s seed %d: the surface collapsed:", f->cell->method->label,
+                                   f->cell->seed);
+    for (int k = 0; k < f->n; k++) {
+        int rc = tcb_frames_collapsed(&mesh[k], f->cell->seq->areas[f->frames[k]], flags, &n_collapsed[k], err);
+        if (rc) return rc;
+        if (n_collapsed[k] && used < sizeof msg)
+            used += (size_t)snprintf(msg + used, sizeof msg - used, "%s %d of %d patches in frame %d",
+                                     any++ ? "," : "", n_collapsed[k], mesh[k].n_charts, f->frames[k]);
+    }
+    if (any)
+        tcb_report_log(&f->cell->reporter, TCB_LOG_WARN,
+                       "%s (a patch is collapsed when its area is under %g %% of its share of the frame's GT "
+                       "surface: area / patches)",
+                       msg, 100 * TCB_FRAMES_COLLAPSED);
+    return TCB_OK;
+}
+
 static int write_strip(const tcb_frames_job *f, const tcb_uv_mesh *mesh, const tcb_checker *c, tcb_error *err)
 {
     const tcb_uv_mesh *m0 = &mesh[0];
     tcb_render_panel panels[TCB_FRAMES_MAX];
-    char titles[TCB_FRAMES_MAX][32], path[TCB_PATH_MAX];
+    char titles[TCB_FRAMES_MAX][64], path[TCB_PATH_MAX];
+    int n_collapsed[TCB_FRAMES_MAX];
+    int rc = collapsed_patches(f, mesh, n_collapsed, err);
+    if (rc) return rc;
     uint8_t *rgb = malloc(3 * (size_t)m0->n_faces);
     if (!rgb) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory for %d faces", m0->n_faces);
     face_colors(m0, c, rgb);
     for (int k = 0; k < f->n; k++) {
-        snprintf(titles[k], sizeof titles[k], "frame %d", f->frames[k]);
+        if (n_collapsed[k])
+            snprintf(titles[k], sizeof titles[k], "frame %d: %d of %d patches collapsed", f->frames[k],
+                     n_collapsed[k], mesh[k].n_charts);
+        else
+            snprintf(titles[k], sizeof titles[k], "frame %d", f->frames[k]);
         panels[k] = (tcb_render_panel){titles[k], mesh[k].verts, NULL, rgb};
     }
     const tcb_sequence *seq = f->cell->seq;
-    int rc = tcb_path_join(path, sizeof path, err, "%s/strip.png", f->dir);
+    rc = tcb_path_join(path, sizeof path, err, "%s/strip.png", f->dir);
     /* The view axis from the GT's first frame, as every strip and inspect's pair.png. */
     if (!rc) rc = tcb_render_panels(path, panels, f->n, m0->n_verts, m0->faces, m0->n_faces,
                                     tcb_seq_frame(seq, 0), seq->n_verts, 0, err);

@@ -5,6 +5,7 @@
  * Every error is one line "tcbench: <message>"; bad usage, bad input and
  * unreadable paths exit 2, other failures 1. */
 #include <errno.h>
+#include <limits.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -45,7 +46,8 @@ static const struct {
 typedef struct cli {
     const char *arg[MAX_ARGS];   /* positional arguments */
     int n_args;
-    const char *value[F_COUNT];  /* last value of each flag taking one */
+    const char *value[F_COUNT];  /* the value of each flag taking one */
+    long long num[F_COUNT];      /* ... as an integer, for the flags of int_flags[] */
     int set[F_COUNT];            /* flag given */
     const char *plugins[MAX_PLUGINS];
     int n_plugins;
@@ -82,22 +84,49 @@ static int usage_error(const char *cmd, const char *fmt, ...)
     return 2;
 }
 
-/* A non-negative integer option, strictly parsed. */
-static int int_option(const cli *c, int f, long long def, long long *out)
+/* The flags that take an integer, and the range each accepts; `cmd` NULL:
+ * in every command that takes the flag. The value is checked when the line
+ * is parsed, before any command runs, so that a 0, a negative number or a
+ * word is never taken for "the default" (--threads 0 was once read so). */
+static const struct int_flag {
+    int flag;
+    const char *cmd;
+    long long min, max;
+} int_flags[] = {
+    {F_THREADS, NULL, 1, 1024},
+    {F_SEED, "datasets", 0, LLONG_MAX},  /* a generator's seed, as a config's dataset "seed" */
+    {F_SEED, NULL, 0, INT_MAX},           /* a cell's seed, as a config's "seeds" */
+    {F_FRAMES, "datasets", 1, 100000},    /* frames per sequence; `frames` takes a list */
+    {F_N_FRAMES, NULL, 1, TCB_FRAMES_MAX},
+    {F_SAMPLES, NULL, 1, 10000000},
+    {F_LOCK_TIMEOUT, NULL, 1, 1000000000},
+};
+
+static const struct int_flag *int_flag_of(const char *cmd, int f)
 {
-    *out = def;
-    const char *s = c->value[f];
-    if (!s) return 0;
+    for (size_t k = 0; k < sizeof int_flags / sizeof int_flags[0]; k++)
+        if (int_flags[k].flag == f && (!int_flags[k].cmd || (cmd && !strcmp(int_flags[k].cmd, cmd))))
+            return &int_flags[k];
+    return NULL;
+}
+
+/* s as flag f's integer: strictly a decimal number within the flag's range. */
+static int parse_int_flag(const char *cmd, int f, const char *s, long long *out)
+{
+    const struct int_flag *r = int_flag_of(cmd, f);
+    if (!r) return 0;
     char *end;
     errno = 0;
     long long v = strtoll(s, &end, 10);
-    if (!*s || *end || errno || v < 0) {
-        fprintf(stderr, "tcbench: %s: expected a non-negative integer, got '%s'\n", flags[f].name, s);
-        return 2;
-    }
+    if (!*s || *end || errno || v < r->min || v > r->max)
+        return usage_error(cmd, "%s: expected an integer from %lld to %lld, got '%s'", flags[f].name, r->min,
+                           r->max, s);
     *out = v;
     return 0;
 }
+
+/* Flag f's integer (checked by parse_int_flag), or `def` when not given. */
+static long long flag_int(const cli *c, int f, long long def) { return c->set[f] ? c->num[f] : def; }
 
 /* ---- commands ------------------------------------------------------- */
 
@@ -106,13 +135,12 @@ static int int_option(const cli *c, int f, long long def, long long *out)
 static int load_config(const cli *c, tcb_config *cfg)
 {
     tcb_error err = {0};
-    long long threads;
-    if (int_option(c, F_THREADS, 0, &threads)) return 2;
+    long long threads = flag_int(c, F_THREADS, 0);
     const char *slurm = getenv("SLURM_CPUS_PER_TASK");
     if (!threads && slurm && atoi(slurm) > 0) threads = atoi(slurm);
     tcb_config_opts co = {c->value[F_VARIANT], c->n_roots, c->roots};
     if (tcb_config_load_opts(c->arg[0], &co, cfg, &err)) return fail(&err);
-    if (threads > 0) cfg->threads = (int)(threads > 1024 ? 1024 : threads);
+    if (threads > 0) cfg->threads = (int)(threads > 1024 ? 1024 : threads); /* Slurm's may be more */
     return 0;
 }
 
@@ -176,16 +204,10 @@ static int cmd_run(const cli *c)
     tcb_term_progress tp;
     tcb_term_progress_init(&tp, stderr, c->set[F_QUIET] ? 1 : -1);
     tp.verbose = c->set[F_VERBOSE];
-    long long lock_timeout;
-    if (int_option(c, F_LOCK_TIMEOUT, 0, &lock_timeout)) {
-        tcb_config_free(&cfg);
-        free(mask);
-        return 2;
-    }
     tcb_stop_signals stop;
     tcb_run_opts opts = {.output = c->value[F_OUT], .only_method = c->value[F_ONLY], .force = c->set[F_FORCE],
                          .reporter = c->set[F_DRY_RUN] ? (tcb_reporter){0} : tcb_term_progress_reporter(&tp),
-                         .cells = mask, .lock_timeout_s = (double)lock_timeout,
+                         .cells = mask, .lock_timeout_s = (double)flag_int(c, F_LOCK_TIMEOUT, 0),
                          .interrupted = tcb_stop_signals_requested, .interrupt_arg = &stop};
     /* Before any thread exists, so that every thread blocks the signals. */
     if (tcb_stop_signals_start(&stop)) fprintf(stderr, "tcbench: cannot watch for SIGTERM; a signal kills the run\n");
@@ -280,9 +302,7 @@ static int synth_index(const char *name)
 
 static int datasets_synth(const cli *c)
 {
-    long long seed, frames;
     if (!c->value[F_OUT]) return usage_error("datasets synth", "%s is required", "--out DIR");
-    if (int_option(c, F_SEED, 0, &seed) || int_option(c, F_FRAMES, 0, &frames)) return 2;
     const char *only = c->value[F_SEQUENCE];
     if (only && synth_index(only) < 0)
         return usage_error("datasets synth", "no synthetic sequence named '%s'", only);
@@ -293,7 +313,7 @@ static int datasets_synth(const cli *c)
         tcb_sequence seq = {0};
         char dir[TCB_PATH_MAX];
         int rc = tcb_path_join(dir, sizeof dir, &err, "%s/%s", c->value[F_OUT], name);
-        if (!rc) rc = tcb_synth_generate(name, (uint64_t)seed, (int)frames, &seq, &err);
+        if (!rc) rc = tcb_synth_generate(name, (uint64_t)flag_int(c, F_SEED, 0), (int)flag_int(c, F_FRAMES, 0), &seq, &err);
         if (!rc) rc = tcb_sequence_write_objdir(&seq, dir, &err);
         if (!rc) fprintf(stderr, "wrote %s/ (%d frames, %d vertices)\n", dir, seq.n_frames, seq.n_verts);
         tcb_sequence_free(&seq);
@@ -304,16 +324,13 @@ static int datasets_synth(const cli *c)
 
 static int datasets_align(const cli *c)
 {
-    long long seed, samples;
     if (c->n_args != 2) return usage_error("datasets align", "missing %s", "DIR");
     if (!c->value[F_OUT]) return usage_error("datasets align", "%s is required", "--out FILE");
     if (c->set[F_FRAMES] || c->set[F_SEQUENCE])
         return usage_error("datasets align", "%s applies to 'datasets synth' only",
                            c->set[F_FRAMES] ? "--frames" : "--sequence");
-    if (int_option(c, F_SEED, 0, &seed) || int_option(c, F_SAMPLES, TCB_ALIGN_DEFAULT_SAMPLES, &samples)) return 2;
-    if (samples < 1 || samples > 10000000)
-        return usage_error("datasets align", "--samples %lld outside 1..10000000", samples);
-    tcb_align_cmd a = {c->value[F_OUT], c->value[F_PLOT], (int)samples, (uint64_t)seed};
+    tcb_align_cmd a = {c->value[F_OUT], c->value[F_PLOT], (int)flag_int(c, F_SAMPLES, TCB_ALIGN_DEFAULT_SAMPLES),
+                       (uint64_t)flag_int(c, F_SEED, 0)};
     tcb_error err = {0};
     if (tcb_datasets_align(c->arg[1], &a, &err)) return fail(&err);
     fprintf(stderr, "wrote %s%s%s\n", a.out, a.plot ? " and " : "", a.plot ? a.plot : "");
@@ -357,8 +374,7 @@ static int cmd_check(const cli *c)
 
 static int cmd_inspect(const cli *c)
 {
-    long long seed, threads, pair = -1;
-    if (int_option(c, F_SEED, -1, &seed) || int_option(c, F_THREADS, 0, &threads)) return 2;
+    long long pair = -1;
     if (strcmp(c->arg[2], "worst") != 0) {
         char *end;
         errno = 0;
@@ -369,9 +385,8 @@ static int cmd_inspect(const cli *c)
     }
     tcb_term_progress tp;
     tcb_term_progress_init(&tp, stderr, c->set[F_QUIET] ? 1 : -1);
-    tcb_inspect_opts o = {c->arg[0], c->arg[1], (int)pair, (int)(seed > 1000000000 ? -1 : seed),
-                          c->value[F_SEQUENCE], c->value[F_OUT],
-                          (int)(threads > 1024 ? 1024 : threads), tcb_term_progress_reporter(&tp)};
+    tcb_inspect_opts o = {c->arg[0], c->arg[1], (int)pair, (int)flag_int(c, F_SEED, -1), c->value[F_SEQUENCE],
+                          c->value[F_OUT], (int)flag_int(c, F_THREADS, 0), tcb_term_progress_reporter(&tp)};
     tcb_error err = {0};
     char dir[TCB_PATH_MAX];
     int rc = tcb_inspect(&o, stdout, dir, &err);
@@ -408,20 +423,16 @@ static int frames_style(const char *s, tcb_frames_style *style)
 
 static int cmd_frames(const cli *c)
 {
-    long long seed, threads, count;
     int frames[TCB_FRAMES_MAX], n = 0;
     tcb_frames_style style = TCB_FRAMES_AUTO;
-    if (int_option(c, F_SEED, -1, &seed) || int_option(c, F_THREADS, 0, &threads) ||
-        int_option(c, F_N_FRAMES, 0, &count))
-        return 2;
     if (c->set[F_FRAMES] && c->set[F_N_FRAMES]) return usage_error("frames", "--frames and --count exclude each other");
     if (c->set[F_FRAMES] && frame_list(c->value[F_FRAMES], frames, &n)) return 2;
     if (frames_style(c->value[F_STYLE], &style)) return 2;
     tcb_term_progress tp;
     tcb_term_progress_init(&tp, stderr, c->set[F_QUIET] ? 1 : -1);
-    tcb_frames_opts o = {c->arg[0], c->arg[1], n ? frames : NULL, n, (int)(count > 1000000 ? 1000000 : count),
-                         (int)(seed > 1000000000 ? -1 : seed), c->value[F_SEQUENCE], c->value[F_OUT],
-                         (int)(threads > 1024 ? 1024 : threads), style, tcb_term_progress_reporter(&tp)};
+    tcb_frames_opts o = {c->arg[0], c->arg[1], n ? frames : NULL, n, (int)flag_int(c, F_N_FRAMES, 0),
+                         (int)flag_int(c, F_SEED, -1), c->value[F_SEQUENCE], c->value[F_OUT],
+                         (int)flag_int(c, F_THREADS, 0), style, tcb_term_progress_reporter(&tp)};
     tcb_error err = {0};
     char dir[TCB_PATH_MAX];
     int rc = tcb_frames(&o, stdout, dir, &err);
@@ -437,9 +448,7 @@ static int cmd_score(const cli *c)
         {F_DATASET, "--dataset D"}, {F_SEQUENCE, "--sequence S"}, {F_PRED, "--pred DIR"}, {F_NAME, "--name LABEL"}};
     for (size_t k = 0; k < sizeof required / sizeof required[0]; k++)
         if (!c->value[required[k].flag]) return usage_error("score", "%s is required", required[k].text);
-    long long seed;
-    if (int_option(c, F_SEED, 0, &seed)) return 2;
-    if (seed > 1000000000) return usage_error("score", "--seed %lld is too large", seed);
+    long long seed = flag_int(c, F_SEED, 0);
     tcb_config cfg;
     int rc = load_config(c, &cfg);
     if (rc) return rc;
@@ -552,9 +561,10 @@ static const command commands[] = {
      "usage: tcbench report RUN_DIR [--reference NAME] [--out DIR] [--quiet]\n"
      "\n"
      "Writes tables.md, tables.tex, results.csv, by_gap.csv, and per sequence the PCK\n"
-     "curves, the geodesic PCK curves and m_sL2 by frame distance as PNG plots, for a\n"
-     "run directory, and prints the Markdown tables (the paper's metrics, then the\n"
-     "geodesic error m_geo and AUC_geo: docs/protocol.md).\n"
+     "curves, the geodesic PCK curves and m_sL2 by frame distance (log scale) as PNG\n"
+     "plots, for a run directory, and prints the Markdown tables (the paper's\n"
+     "metrics, then the geodesic error m_geo and AUC_geo: docs/protocol.md) on\n"
+     "stdout, nothing else there. A method keeps its colour in every plot.\n"
      "\n"
      "With --reference: the run's tables beside the paper's instead, in the paper's\n"
      "shape: ours, the paper's value and ours/paper per cell, and per metric whether\n"
@@ -665,6 +675,8 @@ static const command commands[] = {
      "as they are). Any other method is drawn as its transfer from the first frame:\n"
      "each frame's GT mesh with every vertex in the colour of the place on the body\n"
      "the transfer sent it to (frame_<f>.ply), so colours out of place are errors.\n"
+     "A surface whose patches collapsed (a patch under 5 % of its share of the\n"
+     "frame's GT area) is said so above each frame of the strip and in a warning.\n"
      "\n"
      "options:\n"
      "  --frames F,F,...  the frames (at most 16, distinct)\n"
@@ -775,6 +787,24 @@ static int cmd_help(const cli *c)
 
 /* ---- argument parsing ----------------------------------------------- */
 
+/* --root DATASET=DIR, one per dataset. */
+static int add_root(const char *where, const char *value, cli *c)
+{
+    const char *sep = strchr(value, '=');
+    size_t n = sep ? (size_t)(sep - value) : 0;
+    if (!sep || !n || !sep[1] || n >= sizeof c->root_names[0])
+        return usage_error(where, "--root: expected DATASET=DIR, got '%s'", value);
+    if (c->n_roots == MAX_ROOTS) return usage_error(where, "too many --root options");
+    memcpy(c->root_names[c->n_roots], value, n);
+    c->root_names[c->n_roots][n] = '\0';
+    for (int k = 0; k < c->n_roots; k++)
+        if (!strcmp(c->root_names[k], c->root_names[c->n_roots]))
+            return usage_error(where, "--root: dataset '%s' given twice", c->root_names[k]);
+    c->roots[c->n_roots] = (tcb_root_override){c->root_names[c->n_roots], sep + 1};
+    c->n_roots++;
+    return 0;
+}
+
 /* Parses argv[*i] (a flag) into c; advances *i past a separate value.
  * `cmd` is NULL before the command name, where only global flags apply. */
 static int parse_flag(const command *cmd, int argc, char **argv, int *i, cli *c)
@@ -796,21 +826,16 @@ static int parse_flag(const command *cmd, int argc, char **argv, int *i, cli *c)
     } else if (eq) {
         return usage_error(where, "option '%s' takes no value", name);
     }
+    /* A second value would silently replace the first: which one was meant? */
+    if (value && c->set[f] && f != F_PLUGIN && f != F_ROOT)
+        return usage_error(where, "option '%s' given twice ('%s', then '%s')", name, c->value[f], value);
+    int rc = value ? parse_int_flag(where, f, value, &c->num[f]) : 0;
+    if (rc) return rc;
     if (f == F_PLUGIN) {
         if (c->n_plugins == MAX_PLUGINS) return usage_error(where, "too many %s options", name);
         c->plugins[c->n_plugins++] = value;
     }
-    if (f == F_ROOT) {
-        const char *sep = strchr(value, '=');
-        size_t n = sep ? (size_t)(sep - value) : 0;
-        if (!sep || !n || !sep[1] || n >= sizeof c->root_names[0])
-            return usage_error(where, "--root: expected DATASET=DIR, got '%s'", value);
-        if (c->n_roots == MAX_ROOTS) return usage_error(where, "too many %s options", name);
-        memcpy(c->root_names[c->n_roots], value, n);
-        c->root_names[c->n_roots][n] = '\0';
-        c->roots[c->n_roots] = (tcb_root_override){c->root_names[c->n_roots], sep + 1};
-        c->n_roots++;
-    }
+    if (f == F_ROOT && (rc = add_root(where, value, c))) return rc;
     c->set[f] = 1;
     c->value[f] = value;
     return 0;
@@ -850,6 +875,11 @@ int main(int argc, char **argv)
 {
     cli c = {0};
     int i = 1, rc;
+    /* Tables on stdout, status lines on stderr: line by line, each stream in
+     * the order written, so that `tcbench report > file 2>&1` never finds a
+     * status line inside a table (a fully buffered stdout reached the file
+     * in 4 KiB blocks, after the stderr lines written meanwhile). */
+    setvbuf(stdout, NULL, _IOLBF, 0);
     /* Global flags (--plugin, --help) may precede the command. */
     for (; i < argc && argv[i][0] == '-'; i++)
         if ((rc = parse_flag(NULL, argc, argv, &i, &c))) return rc;

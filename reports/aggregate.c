@@ -106,6 +106,9 @@ static int build_row(const tcb_cell_result *cells, int n, tcb_rpt_row *r, tcb_er
 {
     memset(r, 0, sizeof *r);
     snprintf(r->method, sizeof r->method, "%s", cells[0].method);
+    snprintf(r->method_impl, sizeof r->method_impl, "%s", cells[0].method_impl);
+    const char *params = cells[0].params_json ? cells[0].params_json : "";
+    if (strlen(params) < sizeof r->params) memcpy(r->params, params, strlen(params) + 1);
     r->n_seeds = n;
     r->status = "ok";
     int rc = build_seeds(cells, n, r, err);
@@ -317,6 +320,8 @@ static void mean_row(const tcb_rpt_block *const *tests, int nt, const char *meth
     for (int t = 0; t < nt; t++) {
         const tcb_rpt_row *s = find_row(tests[t], method);
         if (s->n_seeds > r->n_seeds) r->n_seeds = s->n_seeds;
+        if (t == 0) memcpy(r->method_impl, s->method_impl, sizeof r->method_impl);
+        if (t == 0) memcpy(r->params, s->params, sizeof r->params);
         r->n_pairs += s->n_pairs;
         for (int m = 0; m < TCB_N_METRICS; m++) {
             r->has[m] &= s->has[m];

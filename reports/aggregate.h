@@ -60,6 +60,8 @@ typedef struct tcb_rpt_seed {
 
 typedef struct tcb_rpt_row {
     char method[64];
+    char method_impl[64];             /* the registered method of its first cell */
+    char params[256];                 /* that cell's params, compact JSON ("" when longer) */
     const char *status;               /* "ok", "failed", "diverged" or "missing" */
     char status_text[64];             /* status plus how many pooled parts had it */
     char message[TCB_ERRMSG_MAX];     /* first failing cell: "seed 1: …" */

@@ -2,6 +2,7 @@
 #include "reports/chart.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
@@ -21,9 +22,33 @@ static const double PALETTE[][3] = {
     {0.737, 0.741, 0.133}, {0.090, 0.745, 0.812},
 };
 #define N_COLOURS ((int)(sizeof PALETTE / sizeof PALETTE[0]))
+/* Solid, dashed, dotted, dash-dot: a second cue where two labels share a colour. */
+static const double DASHES[][4] = {{0}, {7, 4}, {2, 3}, {8, 3, 2, 3}};
+static const int N_DASH_STEPS[] = {0, 2, 2, 4};
+#define N_DASHES ((int)(sizeof DASHES / sizeof DASHES[0]))
+/* The first salt (tcb_chart_style_of) under which the labels of every shipped
+ * config (configs/, configs/paper/) get distinct colours, and table3-alpha's
+ * sixteen distinct colour-and-dash pairs. */
+#define STYLE_SALT 1439u
 
-double tcb_chart_px(const tcb_chart *c, double x) { return X0 + (X1 - X0) * x / c->x.max; }
-double tcb_chart_py(const tcb_chart *c, double y) { return Y1 - (Y1 - Y0) * y / c->y.max; }
+int tcb_chart_style_of(const char *label)
+{
+    if (!label) return 0;
+    uint32_t h = 2166136261u ^ STYLE_SALT; /* FNV-1a, then murmur3's finalizer: every bit mixes */
+    for (const unsigned char *p = (const unsigned char *)label; *p; p++) h = (h ^ *p) * 16777619u;
+    h ^= h >> 16, h *= 0x85ebca6bu, h ^= h >> 13, h *= 0xc2b2ae35u, h ^= h >> 16;
+    return (int)(h % (N_COLOURS * N_DASHES));
+}
+
+/* Where v lies along the axis, 0 at its start and 1 at its end. */
+static double axis_frac(const tcb_chart_axis *a, double v)
+{
+    if (a->log) return (log10(v) - log10(a->min)) / (log10(a->max) - log10(a->min));
+    return (v - a->min) / (a->max - a->min);
+}
+
+double tcb_chart_px(const tcb_chart *c, double x) { return X0 + (X1 - X0) * axis_frac(&c->x, x); }
+double tcb_chart_py(const tcb_chart *c, double y) { return Y1 - (Y1 - Y0) * axis_frac(&c->y, y); }
 
 static void font(cairo_t *cr, double size, int bold)
 {
@@ -41,47 +66,55 @@ static void text(cairo_t *cr, double x, double y, double align, const char *s)
     cairo_show_text(cr, s);
 }
 
-static void tick_label(const tcb_chart_axis *a, int k, char *out, size_t size)
-{
-    if (k == 0) snprintf(out, size, "0");
-    else snprintf(out, size, a->format, a->max * k / a->n_ticks);
-}
+enum { MAX_TICKS = 64 };
 
-static void draw_x_ticks(tcb_chart *c)
+/* The axis's ticks: linear, n_ticks + 1 labelled ones from min to max; log,
+ * a labelled one at each power of ten and grid lines at 2× and 5×. */
+static int axis_ticks(const tcb_chart_axis *a, double *v, int *labelled)
 {
-    cairo_t *cr = c->cr;
-    for (int k = 0; k <= c->x.n_ticks; k++) {
-        double x = round(tcb_chart_px(c, c->x.max * k / c->x.n_ticks)) + 0.5;
-        char label[32];
-        cairo_set_source_rgb(cr, 0.90, 0.90, 0.90);
-        cairo_move_to(cr, x, Y0);
-        cairo_line_to(cr, x, Y1);
-        cairo_stroke(cr);
-        cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
-        cairo_move_to(cr, x, Y1);
-        cairo_line_to(cr, x, Y1 + 6);
-        cairo_stroke(cr);
-        tick_label(&c->x, k, label, sizeof label);
-        text(cr, x, Y1 + 24, 0.5, label);
+    int n = 0;
+    if (!a->log) {
+        for (int k = 0; k <= a->n_ticks && n < MAX_TICKS; k++, n++)
+            v[n] = a->min + (a->max - a->min) * k / a->n_ticks, labelled[n] = 1;
+        return n;
     }
+    static const double minor[] = {1, 2, 5};
+    for (double d = pow(10.0, floor(log10(a->min) + 1e-9)); d <= a->max * (1 + 1e-9) && n < MAX_TICKS; d *= 10)
+        for (int m = 0; m < 3 && n < MAX_TICKS; m++)
+            if (d * minor[m] >= a->min * (1 - 1e-9) && d * minor[m] <= a->max * (1 + 1e-9))
+                v[n] = d * minor[m], labelled[n++] = m == 0;
+    return n;
 }
 
-static void draw_y_ticks(tcb_chart *c)
+static void tick_label(const tcb_chart_axis *a, double v, char *out, size_t size)
+{
+    if (fabs(v) < 1e-12 * fmax(fabs(a->min), fabs(a->max))) snprintf(out, size, "0");
+    else snprintf(out, size, a->format, v);
+}
+
+/* The grid line, tick mark and label of each tick of the x axis (y: 0)
+ * or the y axis (1). */
+static void draw_ticks(tcb_chart *c, int y_axis)
 {
     cairo_t *cr = c->cr;
-    for (int k = 0; k <= c->y.n_ticks; k++) {
-        double y = round(tcb_chart_py(c, c->y.max * k / c->y.n_ticks)) + 0.5;
+    const tcb_chart_axis *a = y_axis ? &c->y : &c->x;
+    double v[MAX_TICKS];
+    int labelled[MAX_TICKS], n = axis_ticks(a, v, labelled);
+    for (int k = 0; k < n; k++) {
+        double at = round(y_axis ? tcb_chart_py(c, v[k]) : tcb_chart_px(c, v[k])) + 0.5, g = labelled[k] ? 0.90 : 0.95;
+        cairo_set_source_rgb(cr, g, g, g);
+        cairo_move_to(cr, y_axis ? X0 : at, y_axis ? at : Y0);
+        cairo_line_to(cr, y_axis ? X1 : at, y_axis ? at : Y1);
+        cairo_stroke(cr);
+        if (!labelled[k]) continue;
         char label[32];
-        cairo_set_source_rgb(cr, 0.90, 0.90, 0.90);
-        cairo_move_to(cr, X0, y);
-        cairo_line_to(cr, X1, y);
-        cairo_stroke(cr);
         cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
-        cairo_move_to(cr, X0 - 6, y);
-        cairo_line_to(cr, X0, y);
+        cairo_move_to(cr, y_axis ? X0 - 6 : at, y_axis ? at : Y1);
+        cairo_line_to(cr, y_axis ? X0 : at, y_axis ? at : Y1 + 6);
         cairo_stroke(cr);
-        tick_label(&c->y, k, label, sizeof label);
-        text(cr, X0 - 10, y + 5, 1, label);
+        tick_label(a, v[k], label, sizeof label);
+        if (y_axis) text(cr, X0 - 10, at + 5, 1, label);
+        else text(cr, at, Y1 + 24, 0.5, label);
     }
 }
 
@@ -95,8 +128,8 @@ void tcb_chart_begin(tcb_chart *c, const tcb_chart_axis *x, const tcb_chart_axis
     cairo_paint(cr);
     cairo_set_line_width(cr, 1);
     font(cr, 13, 0);
-    draw_x_ticks(c);
-    draw_y_ticks(c);
+    draw_ticks(c, 0);
+    draw_ticks(c, 1);
     cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
     cairo_rectangle(cr, X0 + 0.5, Y0 + 0.5, X1 - X0 - 1, Y1 - Y0 - 1);
     cairo_stroke(cr);
@@ -109,24 +142,23 @@ void tcb_chart_begin(tcb_chart *c, const tcb_chart_axis *x, const tcb_chart_axis
     cairo_restore(cr);
 }
 
-static void set_style(cairo_t *cr, int k)
+static void set_style(cairo_t *cr, const char *label)
 {
-    const double *rgb = PALETTE[k % N_COLOURS];
+    int s = tcb_chart_style_of(label);
+    const double *rgb = PALETTE[s % N_COLOURS];
     cairo_set_source_rgb(cr, rgb[0], rgb[1], rgb[2]);
     cairo_set_line_width(cr, 2.2);
-    /* Past ten methods the colours repeat; dashes keep the lines apart. */
-    static const double dash[] = {7, 4};
-    cairo_set_dash(cr, dash, k >= N_COLOURS ? 2 : 0, 0);
+    cairo_set_dash(cr, DASHES[s / N_COLOURS], N_DASH_STEPS[s / N_COLOURS], 0);
 }
 
-void tcb_chart_series_begin(tcb_chart *c, int k)
+void tcb_chart_series_begin(tcb_chart *c, const char *label)
 {
     cairo_save(c->cr);
     /* A line at exactly the axis end must stay visible, not be half clipped. */
     cairo_rectangle(c->cr, X0, Y0 - 2, X1 - X0, Y1 - Y0 + 2);
     cairo_clip(c->cr);
     cairo_set_line_join(c->cr, CAIRO_LINE_JOIN_ROUND);
-    set_style(c->cr, k);
+    set_style(c->cr, label);
 }
 
 void tcb_chart_series_end(tcb_chart *c) { cairo_restore(c->cr); }
@@ -159,7 +191,7 @@ void tcb_chart_legend(tcb_chart *c, const tcb_rpt_block *b, const char *heading,
         const tcb_rpt_row *r = &b->rows[k];
         char label[160];
         if (!strcmp(r->status, "ok")) {
-            set_style(cr, k);
+            set_style(cr, r->method);
             cairo_move_to(cr, LEGEND_X, y);
             cairo_line_to(cr, LEGEND_X + 28, y);
             cairo_stroke(cr);
@@ -188,6 +220,13 @@ void tcb_chart_headline(tcb_chart *c, const char *title, const char *subtitle)
     font(cr, 13, 0);
     cairo_set_source_rgb(cr, 0.38, 0.38, 0.38);
     text(cr, X0, 58, 0, subtitle);
+}
+
+void tcb_chart_note(tcb_chart *c, const char *note)
+{
+    font(c->cr, 12, 0);
+    cairo_set_source_rgb(c->cr, 0.38, 0.38, 0.38);
+    text(c->cr, X0 - 60, H - 10, 0, note);
 }
 
 void tcb_chart_title(tcb_chart *c, const tcb_rpt_block *b, const char *what)

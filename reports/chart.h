@@ -1,8 +1,8 @@
 /* Private to reports/: the frame every report plot shares, so that a plot
  * file only maps its data. A 900×600 PNG: axes from 0 with a light grid, a
  * legend panel right of the axes (it can never hide a curve), a title with
- * the block's role, pairs and seeds, and one style per method row that is
- * the same in every plot of a block.
+ * the block's role, pairs and seeds, and one style per method label that is
+ * the same in every plot (tcb_chart_style_of).
  *
  * Use: tcb_chart_begin, then for each series tcb_chart_series_begin …
  * cairo drawing at (tcb_chart_px, tcb_chart_py) … tcb_chart_series_end,
@@ -17,10 +17,11 @@
 #include "tcb/error.h"
 
 typedef struct tcb_chart_axis {
-    double max;          /* the axis runs 0 … max */
-    int n_ticks;         /* labelled ticks at max·k / n_ticks, k = 0 … n_ticks */
+    double min, max;     /* the axis runs min … max (log: 0 < min) */
+    int n_ticks;         /* linear: labelled ticks at min + (max − min)·k / n_ticks, k = 0 … n_ticks */
     const char *format;  /* printf format of a tick value ("%.3f"); 0 prints "0" */
     const char *label;
+    int log;             /* logarithmic: a labelled tick at each power of ten, grid lines at 2× and 5× */
 } tcb_chart_axis;
 
 typedef struct tcb_chart {
@@ -36,8 +37,17 @@ void tcb_chart_begin(tcb_chart *c, const tcb_chart_axis *x, const tcb_chart_axis
 double tcb_chart_px(const tcb_chart *c, double x);
 double tcb_chart_py(const tcb_chart *c, double y);
 
-/* Clip to the plot area and take row k's colour, width and dash. */
-void tcb_chart_series_begin(tcb_chart *c, int k);
+/* A method label's style: colour index (style % 10) and dash pattern
+ * (style / 10, solid first) of 40, a function of the label alone, so that
+ * a method keeps its colour in every plot of every report whatever rows
+ * are added or removed. The price of that: two labels can share a colour
+ * (then most often not the dash); the salt is chosen so that the labels of
+ * each shipped config do not. NULL (a plot of one series): 0, the first
+ * colour, solid. */
+int tcb_chart_style_of(const char *label);
+
+/* Clip to the plot area and take the label's colour, width and dash. */
+void tcb_chart_series_begin(tcb_chart *c, const char *label);
 void tcb_chart_series_end(tcb_chart *c);
 
 /* One legend entry per row: "method (value)" with row r's mean of `metric`
@@ -51,6 +61,10 @@ void tcb_chart_headline(tcb_chart *c, const char *title, const char *subtitle);
 /* tcb_chart_headline with "<what> — dataset / sequence" and the block's
  * role, pairs and seeds. */
 void tcb_chart_title(tcb_chart *c, const tcb_rpt_block *b, const char *what);
+
+/* A grey line of small print at the foot of the image, under the x axis's
+ * label: how to read the plot. */
+void tcb_chart_note(tcb_chart *c, const char *note);
 
 /* Writes the PNG to a temporary beside `path` and renames it into place. */
 int tcb_chart_finish(tcb_chart *c, const char *path, tcb_error *err);

@@ -26,14 +26,14 @@ static const double *geo_curve(const tcb_rpt_row *r) { return r->geo_pck; }
 
 static int plot(const tcb_rpt_block *b, const pck_plot *p, const char *path, tcb_error *err)
 {
-    const tcb_chart_axis y = {100.0, 5, "%.0f", "PCK (%)"};
+    const tcb_chart_axis y = {.max = 100.0, .n_ticks = 5, .format = "%.0f", .label = "PCK (%)"};
     tcb_chart c;
     tcb_chart_begin(&c, &p->x, &y);
     for (int k = 0; k < b->n_rows; k++) {
         const tcb_rpt_row *r = &b->rows[k];
         if (strcmp(r->status, "ok") || !r->has[p->metric]) continue;
         const double *pck = p->curve(r);
-        tcb_chart_series_begin(&c, k);
+        tcb_chart_series_begin(&c, r->method);
         for (int s = 0; s < p->steps; s++) {
             double px = tcb_chart_px(&c, p->threshold(s)), py = tcb_chart_py(&c, pck[s]);
             if (s == 0) cairo_move_to(c.cr, px, py);
@@ -49,7 +49,7 @@ static int plot(const tcb_rpt_block *b, const pck_plot *p, const char *path, tcb
 
 int tcb_rpt_plot_pck(const tcb_rpt_block *b, const char *path, tcb_error *err)
 {
-    const pck_plot p = {{TCB_PCK_MAX, 5, "%.3f", "threshold on squared distance"},
+    const pck_plot p = {{.max = TCB_PCK_MAX, .n_ticks = 5, .format = "%.3f", .label = "threshold on squared distance"},
                         tcb_pck_threshold, TCB_PCK_STEPS, TCB_M_AUC, paper_curve,
                         "method (AUC %)", "PCK"};
     return plot(b, &p, path, err);
@@ -57,7 +57,8 @@ int tcb_rpt_plot_pck(const tcb_rpt_block *b, const char *path, tcb_error *err)
 
 int tcb_rpt_plot_pck_geo(const tcb_rpt_block *b, const char *path, tcb_error *err)
 {
-    const pck_plot p = {{TCB_GEO_PCK_MAX, 5, "%.2f", "threshold on geodesic error / sqrt(area)"},
+    const pck_plot p = {{.max = TCB_GEO_PCK_MAX, .n_ticks = 5, .format = "%.2f",
+                         .label = "threshold on geodesic error / sqrt(area)"},
                         tcb_geo_pck_threshold, TCB_GEO_PCK_STEPS, TCB_M_GEO_AUC, geo_curve,
                         "method (AUC_geo %)", "geodesic PCK"};
     return plot(b, &p, path, err);

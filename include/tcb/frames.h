@@ -13,7 +13,10 @@
  *                   8 x 8 checks in two tones of the chart's hue, the check
  *                   at the chart's (0, 0) white (harness/checker.h)
  *   strip.png       the frames side by side, one camera, each face in the
- *                   texture's colour at its UV centroid
+ *                   texture's colour at its UV centroid; a frame whose
+ *                   patches collapsed (area under 5 % of their share of
+ *                   the frame's GT area) is titled so, and a warning
+ *                   through the reporter lists them
  *
  * Every other method (style "transfer") is drawn as its correspondences:
  * the first chosen frame i on its GT mesh with vertices coloured by their

@@ -43,7 +43,7 @@ int tcb_check(const char *run_dir, const char *baseline_path, FILE *out, int *n_
               tcb_error *err);
 
 /* A PNG of the yaw step[f] · 3° the rotation alignment chose per frame
- * (tcb/align.h), written atomically. */
+ * (tcb/align.h), drawn in (−180°, 180°], written atomically. */
 int tcb_plot_yaw(const char *path, const char *sequence, const int *step, int n_frames, int samples,
                  tcb_error *err);
 

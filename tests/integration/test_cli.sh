@@ -32,12 +32,42 @@ expect 2 "no-such.json" "$TCBENCH" run no-such.json
 [ "$(wc -l < err.txt)" -eq 1 ] || { echo "FAIL: error is not one line"; cat err.txt; exit 1; }
 expect 0 "tcbench " "$TCBENCH" version
 
+# ---- integer flags and single-value flags: refused when the line is parsed,
+# before any file is read (x.json need not exist), one line naming the flag
+one_line() { [ "$(wc -l < err.txt)" -eq 1 ] || { echo "FAIL: not one line"; cat err.txt; exit 1; }; }
+for bad in 0 -1 x 1025 2.5 ''; do
+    expect 2 "run: --threads: expected an integer from 1 to 1024, got '$bad'" "$TCBENCH" run x.json --threads "$bad"
+    one_line
+done
+expect 2 "score: --threads: expected an integer from 1 to 1024, got '0'" "$TCBENCH" score x.json --threads 0
+expect 2 "inspect: --threads: expected an integer from 1 to 1024, got '0'" "$TCBENCH" inspect r m 0 --threads 0
+expect 2 "frames: --threads: expected an integer from 1 to 1024, got '-2'" "$TCBENCH" frames r m --threads=-2
+expect 2 "frames: --count: expected an integer from 1 to 16, got '0'" "$TCBENCH" frames r m --count 0
+expect 2 "frames: --count: expected an integer from 1 to 16, got '17'" "$TCBENCH" frames r m --count 17
+expect 2 "frames: --seed: expected an integer from 0 to 2147483647, got '-1'" "$TCBENCH" frames r m --seed -1
+expect 2 "inspect: --seed: expected an integer from 0 to 2147483647, got '3000000000'" \
+    "$TCBENCH" inspect r m 0 --seed 3000000000
+expect 2 "score: --seed: expected an integer from 0 to 2147483647, got 'one'" "$TCBENCH" score x.json --seed one
+expect 2 "run: --lock-timeout: expected an integer from 1 to 1000000000, got '0'" \
+    "$TCBENCH" run x.json --lock-timeout 0
+expect 2 "datasets: --samples: expected an integer from 1 to 10000000, got '0'" \
+    "$TCBENCH" datasets align d --out f.json --samples 0
+expect 2 "datasets: --seed: expected an integer from 0 to 9223372036854775807, got '-5'" \
+    "$TCBENCH" datasets synth --out synth --seed -5
+expect 2 "datasets: --frames: expected an integer from 1 to 100000, got '0'" "$TCBENCH" datasets synth --out s --frames 0
+expect 2 "score: option '--pred' given twice ('a', then 'b')" "$TCBENCH" score x.json --pred a --pred b
+one_line
+expect 2 "run: option '--out' given twice ('a', then 'b')" "$TCBENCH" run x.json --out a --out=b
+expect 2 "frames: option '--style' given twice" "$TCBENCH" frames r m --style texture --style transfer
+expect 2 "run: --root: dataset 'ama' given twice" "$TCBENCH" run x.json --root ama=a --root ama=b
+[ ! -e s ] && [ ! -e a ] || { echo "FAIL: a refused command wrote something"; ls; exit 1; }
+
 # ---- datasets and methods
 expect 0 "quadruped_walk" "$TCBENCH" datasets list
 expect 2 "datasets: unknown action 'frob'" "$TCBENCH" datasets frob
 expect 2 "--out applies to 'datasets synth' only" "$TCBENCH" datasets list --out x
 expect 2 "datasets synth: --out DIR is required" "$TCBENCH" datasets synth
-expect 2 "--frames: expected a non-negative integer, got 'x'" \
+expect 2 "datasets: --frames: expected an integer from 1 to 100000, got 'x'" \
     "$TCBENCH" datasets synth --out synth --frames x
 expect 2 "no synthetic sequence named 'nope'" "$TCBENCH" datasets synth --out synth --sequence nope
 expect 0 "synth/quadruped_walk" "$TCBENCH" datasets synth --out synth --sequence quadruped_walk --frames 3
@@ -84,10 +114,16 @@ grep -qF "bogus" err.txt || { echo "FAIL: bad params not named"; cat err.txt; ex
 sed 's/"pairs": 20/"pairs": 30/' tiny.json > more.json
 expect 2 "splits/synth/quadruped_walk.json" "$TCBENCH" run more.json --out runs/more
 
-# ---- report
+# ---- report: the tables on stdout and nothing else; the status line on
+# stderr, after the tables when both go to one file
 expect 0 "| oracle" "$TCBENCH" report runs/tiny
 grep -qF "runs/tiny/report/" err.txt || { echo "FAIL: report location"; cat err.txt; exit 1; }
 [ -s runs/tiny/report/tables.md ] || { echo "FAIL: no tables.md"; exit 1; }
+cmp out.txt runs/tiny/report/tables.md || { echo "FAIL: report's stdout is not tables.md"; exit 1; }
+"$TCBENCH" report runs/tiny > both.txt 2>&1
+n=$(wc -l < runs/tiny/report/tables.md) # (a sanitizer's summary may follow)
+head -n "$n" both.txt | cmp - runs/tiny/report/tables.md && [ "$(sed -n "$((n + 1))p" both.txt)" = "report: runs/tiny/report/" ] ||
+    { echo "FAIL: report > file 2>&1 is not the tables, then the status line"; cat both.txt; exit 1; }
 expect 0 "rep/" "$TCBENCH" report runs/tiny --out rep --quiet
 [ ! -s out.txt ] || { echo "FAIL: --quiet printed the tables"; exit 1; }
 [ -s rep/tables.md ] && [ -s rep/results.csv ] || { echo "FAIL: report --out"; ls rep; exit 1; }

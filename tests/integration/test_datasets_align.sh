@@ -65,7 +65,7 @@ PY
 # ---- bad input
 expect 2 "datasets align: --out FILE is required" "$TCBENCH" datasets align turned/walk
 expect 2 "datasets align: missing DIR" "$TCBENCH" datasets align --out x.json
-expect 2 "datasets align: --samples 0 outside" "$TCBENCH" datasets align turned/walk --out x.json --samples 0
+expect 2 "datasets: --samples: expected an integer from 1 to 10000000, got '0'" "$TCBENCH" datasets align turned/walk --out x.json --samples 0
 expect 2 "datasets: --plot applies to 'datasets align' only" "$TCBENCH" datasets list --plot p.png
 expect 2 "nowhere: cannot open directory" "$TCBENCH" datasets align nowhere --out x.json
 [ ! -e x.json ] || { echo "FAIL: x.json written despite errors"; exit 1; }

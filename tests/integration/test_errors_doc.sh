@@ -275,6 +275,17 @@ mkdir -p broken && echo '{"name": ' > broken/config.json
 row "its config record unreadable" run split.json --out broken
 row "not a run directory" "$TCBENCH" inspect nowhere nearest 0
 
+# ---- command line
+section "Command-line flags (every command; checked before anything is read)"
+row "\`--threads 0\`" run split.json --threads 0
+row "\`--threads x\`" run split.json --threads x
+row "a negative \`--seed\`" "$TCBENCH" inspect runs/split nearest 0 --seed -1
+row "\`--count 0\`" "$TCBENCH" frames runs/split nearest --count 0
+row "\`--samples 0\`" "$TCBENCH" datasets align data/quadruped_walk --out r.json --samples 0
+row "\`--lock-timeout 0\`" run split.json --lock-timeout 0
+row "a single-value flag given twice" "$TCBENCH" score split.json --dataset synth --sequence quadruped_walk --pred pred --pred other --name files
+row "\`--root\` naming a dataset twice" run split.json --root synth=a --root synth=b
+
 want=$TCB_SOURCE_DIR/docs/errors.md
 if [ "${TCB_UPDATE_ERRORS_DOC:-}" = 1 ]; then
     cp "$doc" "$want"

@@ -11,6 +11,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <cjson/cJSON.h>
+
+#include "tcb/fsutil.h"
 #include "tcb/metrics.h"
 #include "tcb/results.h"
 
@@ -124,6 +127,30 @@ static inline int fake_write(const char *run, const fake_cell *c)
         return 1;
     }
     return 0;
+}
+
+/* Rewrites the cell of (run, dataset, sequence, method, seed 0) through
+ * edit(root, arg) on its JSON, for what fake_write cannot say (another
+ * method_impl, pairs at other distances); returns 0 on success. */
+static inline int fake_edit(const char *run, const fake_cell *c, void (*edit)(cJSON *root, const void *arg),
+                            const void *arg)
+{
+    char path[4096], *text;
+    tcb_error err = {0};
+    if (tcb_cell_path(path, sizeof path, run, c->dataset, c->sequence, c->method, c->seed, &err) ||
+        tcb_read_file(path, &text, NULL, &err)) {
+        fprintf(stderr, "fake_edit: %s\n", err.msg);
+        return 1;
+    }
+    cJSON *root = cJSON_Parse(text);
+    free(text);
+    if (!root) return 1;
+    edit(root, arg);
+    char *out = cJSON_Print(root);
+    cJSON_Delete(root);
+    int rc = !out || tcb_write_file_atomic(path, out, strlen(out), &err);
+    free(out);
+    return rc;
 }
 
 /* Two-pass population mean and std of `n` values. */

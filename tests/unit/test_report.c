@@ -617,6 +617,44 @@ static void test_old_cells_show_dash(void **state)
     tu_remove_tree(dir);
 }
 
+static void set_impl(cJSON *root, const void *impl)
+{
+    cJSON_ReplaceItemInObject(root, "method_impl", cJSON_CreateString(impl));
+}
+
+/* atlasnet and mca cells of the same params, m_sL2 `gap` apart (relative):
+ * tables.md's text. */
+static char *twins_md(double gap)
+{
+    char dir[512], path[4096];
+    tu_make_tmpdir(dir, sizeof dir);
+    const fake_cell a = {"anim", "horse", "test", "AN", 0, TCB_CELL_OK, 0.1, 1, 0},
+                    m = {"anim", "horse", "test", "MCA", 0, TCB_CELL_OK, 0.1 * (1 + gap), 1, 0};
+    assert_int_equal(fake_write(dir, &a) || fake_write(dir, &m), 0);
+    assert_int_equal(fake_edit(dir, &a, set_impl, "atlasnet") || fake_edit(dir, &m, set_impl, "mca"), 0);
+    tcb_error err = {0};
+    if (tcb_report_write(dir, NULL, NULL, &err)) fail_msg("%s", err.msg);
+    snprintf(path, sizeof path, "%s/report/tables.md", dir);
+    char *md = read_all(path);
+    tu_remove_tree(dir);
+    return md;
+}
+
+/* atlasnet and mca 0.5 % apart: the notes under the sequence's table and
+ * the MEAN's say why; 3 % apart: nothing to explain. */
+static void test_atlasnet_mca_agreement_explained(void **state)
+{
+    (void)state;
+    char *md = twins_md(0.005);
+    const char *note = "AN and MCA agree on m_sL2 (", *why = "differ only by mca's metric-consistency term";
+    const char *first = strstr(md, note);
+    if (!first || !strstr(first + 1, note) || !strstr(md, why)) fail_msg("no note twice in:\n%s", md);
+    free(md);
+    md = twins_md(0.03);
+    if (strstr(md, note)) fail_msg("a note for rows 3 %% apart:\n%s", md);
+    free(md);
+}
+
 static void test_empty_run_is_an_error(void **state)
 {
     (void)state;
@@ -650,7 +688,8 @@ int main(void)
         cmocka_unit_test(test_pngs_are_valid),
     };
     const struct CMUnitTest standalone[] = {cmocka_unit_test(test_empty_run_is_an_error),
-                                            cmocka_unit_test(test_old_cells_show_dash)};
+                                            cmocka_unit_test(test_old_cells_show_dash),
+                                            cmocka_unit_test(test_atlasnet_mca_agreement_explained)};
     int failed = cmocka_run_group_tests(tests, setup, teardown);
     return failed + cmocka_run_group_tests(standalone, NULL, NULL);
 }
