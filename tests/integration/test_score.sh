@@ -124,12 +124,12 @@ expect 2 "--name: tiny.json has a method labelled 'nearest' (its cells are tcben
 expect 2 "$cells/nearest_f4/seed_0.json exists: --force replaces it" score --pred nearest_f4 --name nearest_f4
 expect 0 "oracle_i32: 20 pairs, m_sL2 11.56" score --pred nearest_f4 --name oracle_i32 --force
 expect 2 "invalid method name \"a/b\"" score --pred nearest_f4 --name a/b
-expect 2 "score: --pred DIR is required" score --name y
+expect 2 "score: --pred DIR|FILE.npz is required" score --name y
 expect 2 "--dataset: tiny.json has no dataset named 'nope'" \
     "$TCBENCH" score tiny.json --dataset nope --sequence quadruped_walk --pred nearest_f4 --name y
 expect 2 "--sequence: dataset synth of tiny.json has no sequence named 'nope'" \
     "$TCBENCH" score tiny.json --dataset synth --sequence nope --pred nearest_f4 --name y
-expect 2 "nowhere: no such directory" score --pred nowhere --name y
+expect 2 "nowhere: no such file or directory (a directory of <k>.npy or an .npz)" score --pred nowhere --name y
 
 # ---- bad prediction files: an error naming the file, no cell
 # bad CASE PYTHON: a copy of oracle_i32 as bad_CASE, changed by PYTHON
