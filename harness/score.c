@@ -35,6 +35,7 @@ struct tcb_evaluator {
     char split_path[TCB_PATH_MAX];
     double load_s;
     tcb_pair_scorer scorer;
+    tcb_nn *shape;      /* every frame's vertices, for the wrong-frame rule; made when needed */
     int32_t *pred;      /* [nv] one pair's vertex ids */
     float *moved;       /* [nv][3] one pair's points */
     int scored;         /* cell holds the last evaluation */
@@ -103,6 +104,7 @@ void tcb_evaluator_free(tcb_evaluator *ev)
     if (!ev) return;
     tcb_cell_free(&ev->cell);
     tcb_pair_scorer_free(&ev->scorer);
+    tcb_nn_free(ev->shape);
     tcb_split_free(&ev->split);
     tcb_sequence_free(&ev->seq);
     free(ev->pred);
@@ -112,6 +114,7 @@ void tcb_evaluator_free(tcb_evaluator *ev)
 
 const tcb_sequence *tcb_evaluator_sequence(const tcb_evaluator *ev) { return &ev->seq; }
 const tcb_split *tcb_evaluator_split(const tcb_evaluator *ev) { return &ev->split; }
+const char *tcb_evaluator_split_path(const tcb_evaluator *ev) { return ev->split_path; }
 const tcb_cell_result *tcb_evaluator_cell(const tcb_evaluator *ev) { return ev->scored ? &ev->cell : NULL; }
 
 /* {key: origin}, escaped as JSON; malloc'ed, NULL when out of memory. */
@@ -149,11 +152,11 @@ static int wrong_frame(const tcb_sequence *seq, int k, int j, tcb_error *err)
     snprintf(why, sizeof why, "pair %d, target frame %d: %s", k, j, err->msg);
     if (seq->norm == TCB_NORM_NONE)
         return tcb_fail(err, TCB_ERR_INPUT,
-                        "%s; the split's frames are the dataset's own coordinates (normalization \"none\"); "
+                        "%s, not the split's frame. Its frames are the dataset's own coordinates (normalization \"none\"); "
                         "--any-frame (Python: any_frame=True) scores them anyway",
                         why);
     return tcb_fail(err, TCB_ERR_INPUT,
-                    "%s; the split's frames are normalised (normalization \"%s\"): x = (x_raw - norm_shift[j]) / "
+                    "%s, not the split's frame. Its frames are normalised (normalization \"%s\"): x = (x_raw - norm_shift[j]) / "
                     "norm_scale, here norm_shift[%d] = [%.9g, %.9g, %.9g], norm_scale = %.9g (tcbench.load_sequence "
                     "gives both); --any-frame (Python: any_frame=True) scores them anyway",
                     why, tcb_config_norm_names[seq->norm], j, c[0], c[1], c[2], seq->norm_scale);
@@ -170,9 +173,12 @@ static int score_pair(tcb_evaluator *ev, const tcb_predictions *p, int k, int an
     if (rc) return rc;
     rc = tcb_score_prediction_of(&a, seq->n_verts, ev->pred, ev->moved, &is_points, err);
     tcb_npy_free(&a);
+    if (!rc && is_points && !any_frame && !ev->shape)
+        rc = tcb_nn_build(seq->verts, seq->n_verts * seq->n_frames, &ev->shape, err);
     if (!rc && is_points && !any_frame) {
-        rc = tcb_score_check_frame(tcb_seq_frame(seq, j), seq->n_verts, ev->moved, seq->n_verts, err);
-        if (rc) rc = wrong_frame(seq, k, j, err);
+        rc = tcb_score_check_frame(ev->shape, tcb_seq_frame(seq, j), seq->n_verts, ev->moved, seq->n_verts,
+                                   seq->norm_shift + 3 * (size_t)j, seq->norm_scale, err);
+        if (rc == TCB_ERR_INPUT) rc = wrong_frame(seq, k, j, err);
     }
     tcb_pair_prediction pp = {i, j, is_points ? ev->moved : NULL, ev->pred, NAN, NULL};
     if (!rc) rc = tcb_cell_score_pair(&ev->scorer, &pp, &ev->cell.pairs[k], &ev->cell.summary, NULL, err);

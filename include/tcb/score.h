@@ -43,6 +43,7 @@
 #include "tcb/config.h"
 #include "tcb/error.h"
 #include "tcb/metrics.h"
+#include "tcb/nn.h"
 #include "tcb/npy.h"
 #include "tcb/results.h"
 
@@ -82,6 +83,7 @@ int tcb_evaluator_open(const tcb_config *cfg, const char *dataset, const char *s
 void tcb_evaluator_free(tcb_evaluator *ev);
 const tcb_sequence *tcb_evaluator_sequence(const tcb_evaluator *ev);
 const tcb_split *tcb_evaluator_split(const tcb_evaluator *ev);
+const char *tcb_evaluator_split_path(const tcb_evaluator *ev);
 
 /* Every pair of the split read from p and scored (tcb_cell_score_pair, the
  * code that scores a method's cells) into the evaluator's cell, replacing
@@ -122,14 +124,26 @@ typedef struct tcb_score_opts {
 int tcb_score(const tcb_config *cfg, const tcb_score_opts *o, char *cell_path, tcb_summary *summary,
               tcb_error *err);
 
-/* The wrong-frame rule for point predictions (docs/formats.md): with B
- * the axis-aligned bounding box of the target frame's vertices and D its
- * diagonal, the points are in the wrong frame when their median distance
- * to B exceeds TCB_FRAME_TOLERANCE * D. Returns TCB_OK or TCB_ERR_INPUT
- * with a message giving the median (in diagonals); the caller adds the
- * split's normalisation and the way out. (harness/score_frame.c) */
-#define TCB_FRAME_TOLERANCE 0.5
-int tcb_score_check_frame(const float *verts_j, int nv, const float *points, int n, tcb_error *err);
+/* The wrong-frame rule for point predictions (docs/formats.md,
+ * harness/score_frame.c says why and what was measured): shape indexes
+ * the vertices of every frame of the sequence; fit is the points' median
+ * distance to its nearest vertex, fit_raw the same of the points
+ * normalised as the split normalises frame j ((p - shift) / scale, shift
+ * its norm_shift[j], scale norm_scale), D the diagonal of frame j's
+ * bounding box. The points are refused (raw coordinates) when fit >
+ * TCB_FRAME_RAW_RATIO * fit_raw and fit > TCB_FRAME_RAW_MIN * D.
+ * check_frame returns TCB_OK or TCB_ERR_INPUT with a message giving both
+ * medians; the caller adds the split's normalisation and the way out. */
+#define TCB_FRAME_RAW_RATIO 2.0
+#define TCB_FRAME_RAW_MIN 0.01
+typedef struct tcb_frame_fit {
+    double diag;          /* D */
+    double fit, fit_raw;  /* median distances to the nearest vertex (INFINITY: beyond the search's range) */
+} tcb_frame_fit;
+int tcb_frame_fit_measure(const tcb_nn *shape, const float *verts_j, int nv, const float *points, int n,
+                          const double shift[3], double scale, tcb_frame_fit *f, tcb_error *err);
+int tcb_score_check_frame(const tcb_nn *shape, const float *verts_j, int nv, const float *points, int n,
+                          const double shift[3], double scale, tcb_error *err);
 
 /* The readers `tcbench score` and the external method (whose command
  * writes these files) share (harness/score_files.c); errors name the file.
