@@ -144,17 +144,13 @@ static int identity(tcb_evaluator *ev, const tcb_predictions *p, tcb_error *err)
 }
 
 /* The refusal of points in the wrong frame, completed with the split's
- * normalisation of frame j and the way out. */
+ * normalisation of frame j and the way out. (With normalization "none"
+ * the rule refuses nothing: the raw coordinates are the frame.) */
 static int wrong_frame(const tcb_sequence *seq, int k, int j, tcb_error *err)
 {
     const double *c = seq->norm_shift + 3 * (size_t)j;
     char why[TCB_ERRMSG_MAX + 64];
     snprintf(why, sizeof why, "pair %d, target frame %d: %s", k, j, err->msg);
-    if (seq->norm == TCB_NORM_NONE)
-        return tcb_fail(err, TCB_ERR_INPUT,
-                        "%s, not the split's frame. Its frames are the dataset's own coordinates (normalization \"none\"); "
-                        "--any-frame (Python: any_frame=True) scores them anyway",
-                        why);
     return tcb_fail(err, TCB_ERR_INPUT,
                     "%s, not the split's frame. Its frames are normalised (normalization \"%s\"): x = (x_raw - norm_shift[j]) / "
                     "norm_scale, here norm_shift[%d] = [%.9g, %.9g, %.9g], norm_scale = %.9g (tcbench.load_sequence "
