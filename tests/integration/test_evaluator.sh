@@ -14,17 +14,7 @@
 set -euo pipefail
 : "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}" "${TCB_BUILD_DIR:?}"
 . "$(dirname "${BASH_SOURCE[0]}")/expect.sh"
-
-if ! /usr/bin/python3 -c "import numpy" 2>/dev/null; then
-    echo "skipped: /usr/bin/python3 cannot import numpy (scripts/setup.sh installs it)"
-    exit 77
-fi
-lib=$TCB_BUILD_DIR/libtcbench.so
-sanitizer_env=()
-if readelf -d "$lib" | grep -q 'NEEDED.*libasan'; then
-    sanitizer_env=(LD_PRELOAD="$("${CC:-gcc}" -print-file-name=libasan.so)" ASAN_OPTIONS=detect_leaks=0)
-fi
-py() { env "${sanitizer_env[@]}" PYTHONDONTWRITEBYTECODE=1 PYTHONPATH="$TCB_SOURCE_DIR/python" TCBENCH_LIB="$lib" /usr/bin/python3 "$@"; }
+. "$(dirname "${BASH_SOURCE[0]}")/python_env.sh"
 cat_data=${TCB_SHARED_DATA:-$TCB_SOURCE_DIR/../shared/data}/anim
 
 tmp=$(mktemp -d)
@@ -51,32 +41,7 @@ py - <<'PY'
 import os
 import numpy as np
 import tcbench
-
-def same(a, b, at="$"):
-    """Equal JSON values, floats to the bit; arrays bit for bit (nan = nan)."""
-    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
-        bits = {4: np.uint32, 8: np.uint64}[a.dtype.itemsize]
-        assert a.dtype == b.dtype and a.shape == b.shape and np.array_equal(a.view(bits), b.view(bits)), at
-    elif isinstance(a, float) or isinstance(b, float):
-        assert float(a).hex() == float(b).hex(), (at, a, b)
-    elif isinstance(a, dict):
-        assert sorted(a) == sorted(b), (at, sorted(a), sorted(b))
-        for k in a:
-            same(a[k], b[k], f"{at}.{k}")
-    elif isinstance(a, list):
-        assert len(a) == len(b), at
-        for k, (x, y) in enumerate(zip(a, b)):
-            same(x, y, f"{at}[{k}]")
-    else:
-        assert a == b, (at, a, b)
-
-def raises(kind, text, f, *args, **kw):
-    try:
-        f(*args, **kw)
-    except kind as e:
-        assert text in str(e), (str(e), text)
-        return str(e)
-    raise AssertionError(f"no {kind.__name__}: {text}")
+from pychecks import raises, same
 
 ev = tcbench.Evaluator("ev.json", "synth", "quadruped_trot")
 assert ev.pairs.shape == (12, 2) and ev.pairs.dtype == np.int32
@@ -131,8 +96,8 @@ assert ev.write_cell("py_nearest", seed=1).endswith("py_nearest/seed_1.json")
 shift, scale = ev.sequence["norm_shift"], ev.sequence["norm_scale"]
 raw = [verts[i].astype(np.float64) * scale + shift[j] for i, j in ev.pairs]
 np.savez_compressed("raw.npz", **{str(k): p for k, p in enumerate(raw)})
-msg = raises(tcbench.TcbError, 'Its frames are normalised (normalization "first_frame"): x = (x_raw - norm_shift[j]) / norm_scale',
-             ev.evaluate, raw)
+msg = str(raises(tcbench.TcbError, 'Its frames are normalised (normalization "first_frame"): x = (x_raw - norm_shift[j]) / norm_scale',
+             ev.evaluate, raw))
 assert msg.startswith("predictions[0]: pair 0, target frame %d: " % ev.pairs[0][1]), msg
 assert "norm_scale = %.9g" % scale in msg and "any_frame=True" in msg, msg
 bad = ev.evaluate(raw, any_frame=True)["summary"]["sl2"]["mean"]

@@ -155,10 +155,15 @@ bad inf "p = np.zeros((K, 3)); p[0, 2] = -np.inf; np.save(d + '/19.npy', p)"
 bad huge "p = np.zeros((K, 3)); p[4, 0] = 1e30; np.save(d + '/19.npy', p)"
 bad truncated "b = open(d + '/15.npy', 'rb').read(); open(d + '/15.npy', 'wb').write(b[:-100])"
 bad text "open(d + '/15.npy', 'w').write('0 1 2 3\n')"
-while read -r case text; do
-    expect 2 "$text" score --pred "bad_$case" --name bad
-    [ ! -e "$cells/bad" ] || { echo "FAIL: bad_$case: a cell was written"; ls -R "$cells/bad"; exit 1; }
-done <<'CASES'
+# refused SUFFIX: for each "CASE TEXT" line of stdin, scoring bad_CASE<SUFFIX>
+# exits 2 saying TEXT and writes no cell.
+refused() {
+    while read -r case text; do
+        expect 2 "$text" score --pred "bad_$case$1" --name bad
+        [ ! -e "$cells/bad" ] || { echo "FAIL: bad_$case$1: a cell was written"; ls -R "$cells/bad"; exit 1; }
+    done
+}
+refused "" <<'CASES'
 missing bad_missing/7.npy: no such file (one file per pair of splits/synth/quadruped_walk.json: 0.npy to 19.npy)
 surplus bad_surplus/20.npy: splits/synth/quadruped_walk.json has only 20 pairs (0.npy to 19.npy)
 k bad_k/3.npy: shape (2687,): expected (2688,) vertex ids or (2688, 3) points
@@ -225,10 +230,7 @@ bad_npz crc "np.savez(p, **a); b = bytearray(open(p, 'rb').read()); i = b.index(
 bad_npz inflate "np.savez_compressed(p, **a); b = bytearray(open(p, 'rb').read()); i = b.index(b'PK\\x03\\x04'); b[i + 60:i + 80] = bytes(20); open(p, 'wb').write(b)"
 bad_npz truncated "np.savez(p, **a); b = open(p, 'rb').read(); open(p, 'wb').write(b[:len(b) // 2])"
 bad_npz text "open(p, 'w').write('0 1 2 3\\n')"
-while read -r case text; do
-    expect 2 "$text" score --pred "bad_$case.npz" --name bad
-    [ ! -e "$cells/bad" ] || { echo "FAIL: bad_$case.npz: a cell was written"; ls -R "$cells/bad"; exit 1; }
-done <<'CASES'
+refused .npz <<'CASES'
 arr bad_arr.npz: member arr_0.npy: members are named by the pair index (0.npy to 19.npy): np.savez(path, **{str(k): a for k, a in enumerate(arrays)}), not np.savez(path, *arrays)
 missing bad_missing.npz: no member 7.npy (one per pair of splits/synth/quadruped_walk.json: 0.npy to 19.npy)
 surplus bad_surplus.npz: member 20.npy: not a pair of splits/synth/quadruped_walk.json (0.npy to 19.npy): predictions for another split?
