@@ -24,7 +24,8 @@
  * of every cell (tcb/results.h): method <label>, method_impl "scored",
  * params {"pred_dir": <the directory as given>} (or {"pred_file": <the
  * .npz>}, or {"pred": "memory"} from a binding), message "scored from
- * files" ("scored from memory"), no Chamfer distance (the files hold no reconstructions), fit_s 0.
+ * files" ("scored from memory"), no Chamfer distance (the files hold no
+ * reconstructions), fit_s 0.
  * `tcbench report` and `check` read it like any other cell.
  *
  * Points in the wrong frame are refused (tcb_score_check_frame below): the
