@@ -132,9 +132,11 @@ static int parse_entry(const tcb_npz *z, const unsigned char *buf, size_t len, s
 
 static int read_members(tcb_npz *z, const central_dir *cd, tcb_error *err)
 {
-    if (cd->size > CENTRAL_MAX || cd->n > cd->size / CENTRAL_SIZE)
-        return tcb_fail(err, TCB_ERR_INPUT, "%s: central directory of %llu entries in %llu bytes", z->path,
-                        (unsigned long long)cd->n, (unsigned long long)cd->size);
+    if (cd->size > CENTRAL_MAX || cd->n > cd->size / CENTRAL_SIZE || cd->offset > z->file_size ||
+        cd->size > z->file_size - cd->offset)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: central directory of %llu entries in %llu bytes at byte %llu: not in the file",
+                        z->path, (unsigned long long)cd->n, (unsigned long long)cd->size,
+                        (unsigned long long)cd->offset);
     unsigned char *buf = malloc(cd->size ? (size_t)cd->size : 1);
     z->members = calloc(cd->n ? (size_t)cd->n : 1, sizeof *z->members);
     int rc = !buf || !z->members ? tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", z->path) : TCB_OK;
@@ -180,6 +182,11 @@ int tcb_npz_find(const tcb_npz *z, const char *name)
     return -1;
 }
 
+/* Deflate's largest ratio is 1032:1 (RFC 1951's longest match per
+ * 258-byte code): a member claiming more is damaged, and is refused before
+ * its claimed size is allocated. */
+#define INFLATE_RATIO 1032u
+
 /* zlib counts in uInt: the stream is fed and drained in slices of this. */
 #define SLICE ((size_t)1 << 30)
 
@@ -222,8 +229,9 @@ static int member_bytes(const tcb_npz *z, const tcb_npz_member *m, unsigned char
     if (rc) return rc;
     if (u32(h) != SIG_LOCAL) return tcb_fail(err, TCB_ERR_INPUT, "%s: %s: bad local header", z->path, m->name);
     uint64_t data_at = m->header_at + LOCAL_SIZE + u16(h + 26) + u16(h + 28);
-    if (m->raw_size > SIZE_MAX - 1 || m->size > SIZE_MAX || (m->method == 0 && m->size != m->raw_size))
-        return tcb_fail(err, TCB_ERR_INPUT, "%s: %s: sizes %llu and %llu do not fit", z->path, m->name,
+    if (data_at > z->file_size || m->size > z->file_size - data_at || (m->method == 0 && m->size != m->raw_size) ||
+        m->raw_size / INFLATE_RATIO > m->size)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: %s: %llu bytes stored for %llu: a damaged archive", z->path, m->name,
                         (unsigned long long)m->size, (unsigned long long)m->raw_size);
     *raw = malloc(m->raw_size ? (size_t)m->raw_size : 1);
     unsigned char *packed = m->method == 0 ? *raw : malloc(m->size ? (size_t)m->size : 1);
