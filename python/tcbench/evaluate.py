@@ -161,6 +161,7 @@ class Evaluator:
         float64, ``rows`` the same as a structured array with a field per
         column, and the cell's identity fields (split, role, status, ...)."""
         lib = self._lib
+        self.result = None  # a failed evaluation leaves nothing to write (the library's cell is gone too)
         if isinstance(predictions, (str, os.PathLike)):
             cell = lib.text("tcb_binding_evaluator_score", self._handle, 0, None, None, path_bytes(predictions),
                             int(bool(any_frame)))
@@ -184,7 +185,7 @@ class Evaluator:
         (run_dir: the config's output by default), so `tcbench report` and
         `check` show it as a row. Returns the cell's path."""
         if self.result is None:
-            raise RuntimeError("write_cell: nothing evaluated yet (call evaluate first)")
+            raise RuntimeError("write_cell: nothing evaluated yet (call evaluate first; a refused evaluation leaves nothing)")
         path = self._lib.call("tcb_binding_evaluator_write", self._handle,
                               None if run_dir is None else path_bytes(run_dir), label.encode(), int(seed),
                               int(bool(force)))

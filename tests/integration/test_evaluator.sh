@@ -100,6 +100,7 @@ msg = str(raises(tcbench.TcbError, 'Its frames are normalised (normalization "fi
              ev.evaluate, raw))
 assert msg.startswith("predictions[0]: pair 0, target frame %d: " % ev.pairs[0][1]), msg
 assert "norm_scale = %.9g" % scale in msg and "any_frame=True" in msg, msg
+raises(RuntimeError, "write_cell: nothing evaluated yet", ev.write_cell, "after_refusal")
 bad = ev.evaluate(raw, any_frame=True)["summary"]["sl2"]["mean"]
 assert bad > 5 * ref["summary"]["sl2"]["mean"], bad
 # undone as the message says, they are nearest's points again (to float32 rounding)
