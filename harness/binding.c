@@ -9,6 +9,7 @@
 
 #include "harness/internal.h"
 #include "harness/results_format.h"
+#include "tcb/score.h"
 #include "tcb/tcb.h"
 
 /* The dtype names promise these sizes to the binding. */
@@ -223,4 +224,94 @@ int tcb_binding_sequence_copy(const tcb_sequence *s, const char *name, void *dst
         return TCB_OK;
     }
     return tcb_fail(err, TCB_ERR_INPUT, "sequence %s has no array named '%s'", s->name, name);
+}
+
+/* ---- the evaluator */
+
+struct tcb_binding_evaluator {
+    tcb_config cfg;
+    tcb_evaluator *ev;
+};
+
+tcb_binding_evaluator *tcb_binding_evaluator_open(const char *config_path, const char *dataset,
+                                                  const char *sequence, const char *root, const char *variant,
+                                                  tcb_error *err)
+{
+    tcb_root_override ov = {dataset, root};
+    tcb_config_opts opts = {variant, root ? 1 : 0, &ov};
+    tcb_binding_evaluator *e = calloc(1, sizeof *e);
+    if (!e) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory"), NULL;
+    if (tcb_config_load_opts(config_path, &opts, &e->cfg, err)) {
+        free(e);
+        return NULL;
+    }
+    if (!tcb_evaluator_open(&e->cfg, dataset, sequence, &e->ev, err)) return e;
+    tcb_binding_evaluator_free(e);
+    return NULL;
+}
+
+void tcb_binding_evaluator_free(tcb_binding_evaluator *e)
+{
+    if (!e) return;
+    tcb_evaluator_free(e->ev);
+    tcb_config_free(&e->cfg);
+    free(e);
+}
+
+const tcb_sequence *tcb_binding_evaluator_sequence(const tcb_binding_evaluator *e)
+{
+    return tcb_evaluator_sequence(e->ev);
+}
+
+char *tcb_binding_evaluator_split_json(const tcb_binding_evaluator *e, tcb_error *err)
+{
+    char *text = tcb_split_json(tcb_evaluator_split(e->ev));
+    cJSON *o = text ? cJSON_Parse(text) : NULL;
+    free(text);
+    int ok = o && cJSON_AddStringToObject(o, "path", tcb_evaluator_split_path(e->ev)) &&
+             cJSON_AddStringToObject(o, "run_dir", e->cfg.output);
+    return text_of(kept(o, ok), err);
+}
+
+/* Predictions handed over as .npy bytes, one buffer per pair. */
+typedef struct memory_arrays {
+    const void *const *arrays;
+    const size_t *len;
+} memory_arrays;
+
+static int memory_read(void *ctx, int k, tcb_npy *a, char name[TCB_PATH_MAX], tcb_error *err)
+{
+    const memory_arrays *m = ctx;
+    snprintf(name, TCB_PATH_MAX, "predictions[%d]", k);
+    int rc = tcb_npy_parse(m->arrays[k], m->len[k], a, err);
+    if (rc) tcb_error_prefix(err, "%s: ", name);
+    return rc;
+}
+
+char *tcb_binding_evaluator_score(tcb_binding_evaluator *e, int n, const void *const *arrays, const size_t *len,
+                                  const char *path, int any_frame, tcb_error *err)
+{
+    const tcb_split *split = tcb_evaluator_split(e->ev);
+    memory_arrays m = {arrays, len};
+    tcb_predictions p = {memory_read, &m, "pred", "memory", "scored from memory"};
+    int rc = TCB_OK;
+    if (path) rc = tcb_predictions_open(path, split->n_pairs, tcb_evaluator_split_path(e->ev), &p, err);
+    else if (n != split->n_pairs)
+        rc = tcb_fail(err, TCB_ERR_INPUT, "predictions: %d arrays for the %d pairs of %s", n, split->n_pairs,
+                      tcb_evaluator_split_path(e->ev));
+    if (!rc) rc = tcb_evaluator_score(e->ev, &p, any_frame, err);
+    if (path) tcb_predictions_close(&p);
+    if (rc) return NULL;
+    cJSON *root = tcb_cell_to_json("evaluation", tcb_evaluator_cell(e->ev), err);
+    return root ? text_of(root, err) : NULL;
+}
+
+char *tcb_binding_evaluator_write(tcb_binding_evaluator *e, const char *run_dir, const char *label, int seed,
+                                  int force, tcb_error *err)
+{
+    char path[TCB_PATH_MAX];
+    if (tcb_evaluator_write(e->ev, run_dir ? run_dir : e->cfg.output, label, seed, force, path, err)) return NULL;
+    char *copy = strdup(path);
+    if (!copy) tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
+    return copy;
 }

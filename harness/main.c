@@ -20,7 +20,7 @@ enum {
     F_OUT, F_ONLY, F_FORCE, F_QUIET, F_REPORT, F_SEED, F_FRAMES, F_SEQUENCE, F_UPDATE,
     F_PLUGIN, F_THREADS, F_VERBOSE, F_SAMPLES, F_PLOT, F_ROOT, F_VARIANT, F_DRY_RUN, F_REFERENCE, F_CELL,
     F_SHARD, F_LOCK_TIMEOUT, F_DATASET, F_PRED, F_NAME, F_HELP,
-    F_N_FRAMES, F_STYLE, F_COUNT
+    F_N_FRAMES, F_STYLE, F_ANY_FRAME, F_COUNT
 };
 #define BIT(f) (1u << (f))
 
@@ -37,6 +37,7 @@ static const struct {
     [F_CELL] = {"--cell", 1},    [F_SHARD] = {"--shard", 1},   [F_LOCK_TIMEOUT] = {"--lock-timeout", 1},
     [F_DATASET] = {"--dataset", 1}, [F_PRED] = {"--pred", 1},  [F_NAME] = {"--name", 1},
     [F_HELP] = {"--help", 0},    [F_N_FRAMES] = {"--count", 1}, [F_STYLE] = {"--style", 1},
+    [F_ANY_FRAME] = {"--any-frame", 0},
 };
 
 #define MAX_PLUGINS 64
@@ -445,7 +446,7 @@ static int cmd_frames(const cli *c)
 static int cmd_score(const cli *c)
 {
     static const struct { int flag; const char *text; } required[] = {
-        {F_DATASET, "--dataset D"}, {F_SEQUENCE, "--sequence S"}, {F_PRED, "--pred DIR"}, {F_NAME, "--name LABEL"}};
+        {F_DATASET, "--dataset D"}, {F_SEQUENCE, "--sequence S"}, {F_PRED, "--pred DIR|FILE.npz"}, {F_NAME, "--name LABEL"}};
     for (size_t k = 0; k < sizeof required / sizeof required[0]; k++)
         if (!c->value[required[k].flag]) return usage_error("score", "%s is required", required[k].text);
     long long seed = flag_int(c, F_SEED, 0);
@@ -453,7 +454,7 @@ static int cmd_score(const cli *c)
     int rc = load_config(c, &cfg);
     if (rc) return rc;
     tcb_score_opts o = {c->value[F_DATASET], c->value[F_SEQUENCE], c->value[F_PRED], c->value[F_NAME], (int)seed,
-                        c->value[F_OUT], c->set[F_FORCE]};
+                        c->value[F_OUT], c->set[F_FORCE], c->set[F_ANY_FRAME]};
     tcb_error err = {0};
     char path[TCB_PATH_MAX];
     tcb_summary s;
@@ -695,38 +696,46 @@ static const command commands[] = {
      "  tcbench frames runs/quick nearest --count 4\n"},
     {"score", cmd_score,
      BIT(F_DATASET) | BIT(F_SEQUENCE) | BIT(F_PRED) | BIT(F_NAME) | BIT(F_SEED) | BIT(F_OUT) | BIT(F_FORCE) |
-         BIT(F_ROOT) | BIT(F_VARIANT) | BIT(F_THREADS),
+         BIT(F_ROOT) | BIT(F_VARIANT) | BIT(F_THREADS) | BIT(F_ANY_FRAME),
      1, 1, "CONFIG",
-     "usage: tcbench score CONFIG --dataset D --sequence S --pred DIR --name LABEL [--seed S]\n"
-     "                    [--out DIR] [--force] [--root DATASET=DIR]... [--variant NAME] [--threads N]\n"
+     "usage: tcbench score CONFIG --dataset D --sequence S --pred DIR|FILE.npz --name LABEL\n"
+     "                    [--seed S] [--out DIR] [--force] [--any-frame] [--root DATASET=DIR]...\n"
+     "                    [--variant NAME] [--threads N]\n"
      "\n"
-     "Scores correspondences computed anywhere as a cell of the config's run. DIR\n"
-     "holds one NumPy .npy file per evaluation pair of the sequence's common split,\n"
-     "named by the pair's index (0.npy, 1.npy, ...; pair k is the split file's\n"
-     "pairs[k] = [i, j]): for each of the K vertices of frame i, either the predicted\n"
-     "vertex id of frame j (integers, shape (K,)) or the predicted point on frame j\n"
-     "(float32 or float64, shape (K, 3), projected onto frame j's vertices as a\n"
-     "method's transfer is). The pairs are scored by the code that scores a method's\n"
-     "cells, and the cell goes to RUN/cells/D/S/LABEL/seed_<S>.json, so 'report' and\n"
-     "'check' show it as a row (CD '-': the files hold no reconstructions). A missing\n"
-     "file, a wrong shape or dtype, an id out of range, a NaN or a file that is no\n"
-     ".npy is an error naming the file, and nothing is written. docs/formats.md\n"
-     "describes the files, with a numpy example.\n"
+     "Scores correspondences computed anywhere as a cell of the config's run. The\n"
+     "predictions hold one NumPy array per evaluation pair of the sequence's common\n"
+     "split, named by the pair's index (pair k is the split file's pairs[k] = [i, j]):\n"
+     "a directory of .npy files 0.npy, 1.npy, ..., or one .npz whose members are\n"
+     "those files (np.savez(FILE, **{str(k): a_k}); stored or deflated). For each of\n"
+     "the K vertices of frame i, the array holds either the predicted vertex id of\n"
+     "frame j (integers, shape (K,)) or the predicted point on frame j (float32 or\n"
+     "float64, shape (K, 3), in the split's normalised frame, projected onto frame\n"
+     "j's vertices as a method's transfer is). The pairs are scored by the code that\n"
+     "scores a method's cells, and the cell goes to RUN/cells/D/S/LABEL/seed_<S>.json,\n"
+     "so 'report' and 'check' show it as a row (CD '-': no reconstructions). A\n"
+     "missing or surplus file or member, a wrong shape or dtype, an id out of range,\n"
+     "a NaN, points mostly farther than half a box diagonal from frame j's bounding\n"
+     "box (another frame: the error says the split's normalisation) are errors\n"
+     "naming the file, and nothing is written. docs/formats.md describes the files,\n"
+     "with a numpy example.\n"
      "\n"
      "options:\n"
      "  --dataset D     a dataset of the config\n"
      "  --sequence S    one of its sequences\n"
-     "  --pred DIR      the prediction files\n"
+     "  --pred P        the predictions: a directory of <k>.npy, or an .npz\n"
      "  --name LABEL    the row's name; not a label of one of the config's methods\n"
      "  --seed S        the cell's seed (default 0): several prediction sets of one\n"
      "                  method are several seeds of one row\n"
      "  --out DIR       run directory (default: the config's \"output\")\n"
      "  --force         replace the cell when it exists\n"
+     "  --any-frame     score points however far they lie from the target frame\n"
      "  --root D=DIR    the data of dataset D, as for run\n"
      "  --variant NAME  the config's variant, as for run\n"
      "  --threads N     threads for the projection and the metrics\n"
      "\n"
-     "example:\n"
+     "examples:\n"
+     "  tcbench score configs/quick.json --dataset synth --sequence quadruped_trot \\\n"
+     "      --pred results.npz --name my_method\n"
      "  tcbench score configs/quick.json --dataset synth --sequence quadruped_walk \\\n"
      "      --pred predictions/ --name my_method\n"},
     {"version", cmd_version, 0, 0, 0, "",

@@ -12,6 +12,7 @@ packages=(
   libflann-dev liblz4-dev                 # k-NN (FLANN's C API; its headers want lz4)
   libhdf5-dev                             # binary sequence cache
   libcairo2-dev fonts-dejavu-core         # PNG plots with text
+  zlib1g-dev                              # .npz results files (deflate, CRC-32)
   libopenblas-openmp-dev                  # dense linear algebra (the OpenMP build: one thread pool)
   libcmocka-dev                           # unit-test framework
   python3 python3-numpy python3-scipy     # tests: JSON comparisons, scipy reference for linear assignment

@@ -67,6 +67,37 @@ char *tcb_binding_sequence_json(const tcb_sequence *s, tcb_error *err);
 /* Copies array `name` into dst, whose size must be the array's in bytes. */
 int tcb_binding_sequence_copy(const tcb_sequence *s, const char *name, void *dst, size_t size, tcb_error *err);
 
+/* ---- the evaluator (tcb/score.h): whole splits scored as `tcbench score`
+ * scores them, by the same functions. */
+typedef struct tcb_binding_evaluator tcb_binding_evaluator;
+
+/* The config read as the CLI reads it (variant and root as --variant and
+ * --root DATASET=DIR; NULL: the defaults), the sequence and its split
+ * loaded as `tcbench score` loads them. NULL on failure. */
+tcb_binding_evaluator *tcb_binding_evaluator_open(const char *config_path, const char *dataset,
+                                                  const char *sequence, const char *root, const char *variant,
+                                                  tcb_error *err);
+void tcb_binding_evaluator_free(tcb_binding_evaluator *e);
+/* The loaded sequence, for tcb_binding_sequence_json and _copy; owned by e. */
+const tcb_sequence *tcb_binding_evaluator_sequence(const tcb_binding_evaluator *e);
+/* {"path": the split file, "run_dir": the config's output, and the split
+ * file's fields as tcb_binding_split_json gives them}; NULL on failure. */
+char *tcb_binding_evaluator_split_json(const tcb_binding_evaluator *e, tcb_error *err);
+/* Scores n arrays, arrays[k] the bytes of a .npy file of len[k] bytes (pair
+ * k's prediction, read by the .npy reader the files go through; named
+ * "predictions[k]" in messages), or, with n = 0 and path set, the
+ * directory or .npz at path. Returns the evaluation as the JSON text of a
+ * cell file (tcb_binding_cell_json's; method "" and seed 0); NULL on
+ * failure. any_frame: as --any-frame. */
+char *tcb_binding_evaluator_score(tcb_binding_evaluator *e, int n, const void *const *arrays, const size_t *len,
+                                  const char *path, int any_frame, tcb_error *err);
+/* The last evaluation written as the cell <run_dir>/cells/…/<label>/
+ * seed_<seed>.json (run_dir NULL: the config's output), as `tcbench score
+ * --name label --seed seed [--force]` writes it; returns its path (NULL on
+ * failure). */
+char *tcb_binding_evaluator_write(tcb_binding_evaluator *e, const char *run_dir, const char *label, int seed,
+                                  int force, tcb_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -35,7 +35,8 @@
  *     "pairs": [[…], …] }                    (cd is null without reconstruction)
  * "message" says why a failed or diverged cell failed; a cell written by
  * `tcbench score` (tcb/score.h) says "scored from files" there, with
- * method_impl "scored" and params {"pred_dir": …}.
+ * method_impl "scored" and params {"pred_dir": …} ({"pred_file": …} from an
+ * .npz; {"pred": "memory"} and message "scored from memory" from a binding).
  * The geodesic keys (tcb/geodesic.h: geo is the normalised geodesic error,
  * geo_unreachable the count of vertices scored by the Euclidean fallback)
  * came later in the same format: a cell file without them (the four

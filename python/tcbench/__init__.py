@@ -6,6 +6,8 @@
     i, j = split["pairs"][0]
     m = tcbench.pair_metrics(seq["verts"][j], my_predicted_vertex_ids)
     cell = tcbench.read_cell("runs/quick/cells/synth/quadruped_walk/nearest/seed_0.json")
+    ev = tcbench.Evaluator("configs/quick.json", "synth", "quadruped_trot")
+    result = ev.evaluate({k: my_ids_or_points(i, j) for k, (i, j) in enumerate(ev.pairs)})
 
 Every number comes from libtcbench, computed by the code `tcbench run`
 uses, so it equals what the cell files hold to the last bit; every error
@@ -15,15 +17,17 @@ dependency. _lib.py says how the library is found (TCBENCH_LIB first).
 
 from __future__ import annotations
 
-import math
 import os
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ._convert import cell_of, sequence_of
 from ._lib import ENV_VAR, TcbError, library, path_bytes
+from .evaluate import Evaluator
 
-__all__ = ["TcbError", "pair_metrics", "load_split", "load_sequence", "read_cell", "library_path", "ENV_VAR"]
+__all__ = ["TcbError", "pair_metrics", "load_split", "load_sequence", "read_cell", "library_path", "ENV_VAR",
+           "Evaluator"]
 
 # Columns of a cell's pair row that a prediction alone does not determine:
 # the frames, the Chamfer distance of a method's reconstructions, and the
@@ -122,10 +126,7 @@ def read_cell(path: str | os.PathLike) -> dict:
     with ``pairs`` as an (n_pairs, len(pair_columns)) float64 array whose
     columns are ``pair_columns`` (null, e.g. cd without reconstruction, is
     nan)."""
-    cell = library().text("tcb_binding_cell_json", path_bytes(path))
-    rows = [[math.nan if x is None else x for x in row] for row in cell["pairs"]]
-    cell["pairs"] = np.array(rows, dtype=np.float64).reshape(-1, len(cell["pair_columns"]))
-    return cell
+    return cell_of(library().text("tcb_binding_cell_json", path_bytes(path)))
 
 
 def load_sequence(config: str | os.PathLike, dataset: str, sequence: str,
@@ -144,12 +145,6 @@ def load_sequence(config: str | os.PathLike, dataset: str, sequence: str,
     handle = lib.call("tcb_binding_sequence_load", path_bytes(config), dataset.encode(), sequence.encode(),
                       None if root is None else path_bytes(root))
     try:
-        seq = lib.text("tcb_binding_sequence_json", handle)
-        for name, spec in seq.pop("arrays").items():
-            a = np.empty(spec["shape"], dtype=spec["dtype"])
-            lib.call("tcb_binding_sequence_copy", handle, name.encode(), a.ctypes.data, a.nbytes)
-            seq[name] = a
+        return sequence_of(lib, handle)
     finally:
         lib.c.tcb_binding_sequence_free(handle)
-    seq["norm_scale"] = float(seq["norm_scale"])
-    return seq

@@ -218,7 +218,7 @@ conf subjects.json '{"datasets": [{"name": "dfaust", "source": "dfaust", "root":
 row "a subject neither file holds" run subjects.json
 
 # ---- npy
-section "Predictions (\`.npy\`, \`tcbench score\`)"
+section "Predictions (\`.npy\`, \`.npz\`, \`tcbench score\`)"
 # npy DIR K DESCR SHAPE [VALUES]: DIR/K.npy, format 1.0, zeros unless given.
 npy() {
     /usr/bin/python3 - "$@" <<'PY'
@@ -255,6 +255,44 @@ preds; npy pred 1 '<i4' "($K,)" "[$K] * $K"
 row "a vertex id out of range" score
 preds; npy pred 1 '<f4' "($K, 3)" "[float('nan')] * (3 * $K)"
 row "a NaN point" score
+# raw: each pair's points are frame i's OBJ vertices, not normalised as the split's frames are
+raw() {
+    /usr/bin/python3 - <<'PY'
+import json, struct
+pairs = json.load(open("splits/synth/quadruped_walk.json"))["pairs"]
+for k, (i, j) in enumerate(pairs):
+    v = [float(x) for l in open("data/quadruped_walk/mesh_%04d.obj" % i) if l.startswith("v ") for x in l.split()[1:4]]
+    head = "{'descr': '<f4', 'fortran_order': False, 'shape': (%d, 3), }" % (len(v) // 3)
+    head += " " * (63 - (10 + len(head)) % 64) + "\n"
+    with open("pred/%d.npy" % k, "wb") as f:
+        f.write(b"\x93NUMPY\x01\x00" + struct.pack("<H", len(head)) + head.encode() + struct.pack("<%df" % len(v), *v))
+PY
+}
+preds; raw
+row "points in the dataset's raw coordinates (--any-frame scores them)" score
+row "no such file or directory" "$TCBENCH" score split.json --dataset synth --sequence quadruped_walk --pred nowhere --name files --out scored
+# npz [RENAME...]: pred/*.npy as pred.npz (np.savez's layout: stored members), member OLD renamed NEW per OLD=NEW
+npz() {
+    /usr/bin/python3 - "$@" <<'PY'
+import os, sys, zipfile
+rename = dict(a.split("=") for a in sys.argv[1:])
+with zipfile.ZipFile("pred.npz", "w") as z:
+    for name in sorted(os.listdir("pred")):
+        if rename.get(name, name):
+            z.write("pred/" + name, rename.get(name, name))
+PY
+}
+scorez() { "$TCBENCH" score split.json --dataset synth --sequence quadruped_walk --pred pred.npz --name files --out scored --force; }
+preds; npz 0.npy=arr_0.npy 1.npy=arr_1.npy
+row "an .npz with np.savez's positional names" scorez
+preds; npz 1.npy=
+row "an .npz without a pair's member" scorez
+preds; npy pred 2 '<i4' "($K,)"; npz
+row "an .npz member that is no pair's" scorez
+preds; npz; flip pred.npz
+row "an .npz damaged" scorez
+echo "0 1 2" > pred.npz
+row "not an .npz (no ZIP archive)" scorez
 
 # ---- run directory
 section "Run directory"

@@ -13,20 +13,7 @@
 set -euo pipefail
 : "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}" "${TCB_BUILD_DIR:?}"
 . "$(dirname "${BASH_SOURCE[0]}")/expect.sh"
-
-if ! /usr/bin/python3 -c "import numpy" 2>/dev/null; then
-    echo "skipped: /usr/bin/python3 cannot import numpy (scripts/setup.sh installs it)"
-    exit 77
-fi
-lib=$TCB_BUILD_DIR/libtcbench.so
-
-# A sanitized library (TCB_SANITIZE) loads into python only after the ASan
-# runtime, and the interpreter's own allocations are not ours to leak-check.
-sanitizer_env=()
-if readelf -d "$lib" | grep -q 'NEEDED.*libasan'; then
-    sanitizer_env=(LD_PRELOAD="$("${CC:-gcc}" -print-file-name=libasan.so)" ASAN_OPTIONS=detect_leaks=0)
-fi
-py() { env "${sanitizer_env[@]}" PYTHONDONTWRITEBYTECODE=1 PYTHONPATH="$TCB_SOURCE_DIR/python" TCBENCH_LIB="$lib" /usr/bin/python3 "$@"; }
+. "$(dirname "${BASH_SOURCE[0]}")/python_env.sh"
 
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -70,24 +57,9 @@ py - "$lib" <<'PY'
 import csv, glob, json, math, os, sys
 import numpy as np
 import tcbench
+from pychecks import raises, same
 
 assert tcbench.library_path() == sys.argv[1], tcbench.library_path()
-
-def same(a, b, at="$"):
-    """Equal JSON values, floats to the bit (nan for null in the arrays)."""
-    if isinstance(a, float) or isinstance(b, float):
-        assert isinstance(a, (int, float)) and isinstance(b, (int, float)), (at, a, b)
-        assert float(a).hex() == float(b).hex(), (at, a, b)
-    elif isinstance(a, dict):
-        assert sorted(a) == sorted(b), (at, sorted(a), sorted(b))
-        for k in a:
-            same(a[k], b[k], f"{at}.{k}")
-    elif isinstance(a, list):
-        assert len(a) == len(b), (at, len(a), len(b))
-        for k, (x, y) in enumerate(zip(a, b)):
-            same(x, y, f"{at}[{k}]")
-    else:
-        assert type(a) == type(b) and a == b, (at, a, b)
 
 # ---- read_cell: the file's JSON, the pairs as a float array
 cells = sorted(glob.glob("runs/py/cells/*/*/*/seed_0.json"))
@@ -174,14 +146,6 @@ oracle = tcbench.pair_metrics(seq["verts"][3], np.arange(2688, dtype=np.uint16))
 assert oracle["m_sl2"] == 0 and oracle["auc"] == 1 and not oracle["rank"].any()
 
 # ---- errors: the C library's messages, or ValueError before the call
-def raises(kind, text, f, *args):
-    try:
-        f(*args)
-    except kind as e:
-        assert text in str(e), (str(e), text)
-        return e
-    raise AssertionError(f"no {kind.__name__}: {text}")
-
 e = raises(tcbench.TcbError, "metrics: pred[5] = 2688 outside [0, 2688)", tcbench.pair_metrics,
            seq["verts"][0], np.where(np.arange(2688) == 5, 2688, 0))
 assert e.code == "input"
