@@ -8,40 +8,18 @@
 # TCBENCH_LIB): the library it loads is the one inside the venv, and it
 # computes. `pip uninstall` takes the library with it; `pip install ./python`
 # fails saying to install from the root.
-# setup.py builds the library in TCBENCH_CMAKE_BUILD_DIR, here the test's own
-# build (only bringing tcbench_lib up to date: seconds, not a rebuild);
-# TCB_TEST_PIP_FRESH_BUILD=1 leaves it unset, so pip configures and builds a
-# Release library from scratch in the copy, as a user's `pip install .` does.
-# Skipped when /usr/bin/python3 lacks numpy, venv with pip, setuptools or wheel.
+# The install is tests/integration/venv.sh's (TCB_TEST_PIP_FRESH_BUILD=1: a
+# build from scratch, as a user's). Skipped when /usr/bin/python3 lacks
+# numpy, venv with pip, setuptools or wheel.
 set -euo pipefail
 : "${TCB_SOURCE_DIR:?}" "${TCB_BUILD_DIR:?}"
-
-py=/usr/bin/python3
-if ! "$py" -c "import numpy, setuptools, wheel, ensurepip, venv" 2>/dev/null; then
-    echo "skipped: /usr/bin/python3 lacks numpy, setuptools, wheel or venv (scripts/setup.sh installs them)"
-    exit 77
-fi
+. "$(dirname "${BASH_SOURCE[0]}")/venv.sh"
 
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-mkdir "$tmp/src" "$tmp/empty" "$tmp/home"
-
-# The checkout's files as git sees them (tracked, and new files not ignored).
-if git -C "$TCB_SOURCE_DIR" rev-parse --git-dir > /dev/null 2>&1; then
-    (cd "$TCB_SOURCE_DIR" && git ls-files -z --cached --others --exclude-standard |
-        tar --null -T - --ignore-failed-read -cf - 2> /dev/null) | tar -C "$tmp/src" -xf -
-else
-    tar -C "$TCB_SOURCE_DIR" --exclude='./build*' --exclude=./.git -cf - . | tar -C "$tmp/src" -xf -
-fi
+mkdir "$tmp/empty"
+venv_install "$tmp" || { echo "FAIL: pip install"; cat "$tmp/pip.log"; exit 1; }
 test -f "$tmp/src/pyproject.toml" && test -f "$tmp/src/setup.py" || { echo "FAIL: no pyproject.toml/setup.py in the copy"; exit 1; }
-
-build_dir=("TCBENCH_CMAKE_BUILD_DIR=$TCB_BUILD_DIR")
-[ "${TCB_TEST_PIP_FRESH_BUILD:-}" = 1 ] && build_dir=()
-"$py" -m venv --system-site-packages "$tmp/venv"
-if ! (cd "$tmp/home" && env "${build_dir[@]}" PIP_DISABLE_PIP_VERSION_CHECK=1 PIP_NO_CACHE_DIR=1 \
-        "$tmp/venv/bin/pip" install --no-build-isolation --no-index "$tmp/src") > "$tmp/pip.log" 2>&1; then
-    echo "FAIL: pip install"; cat "$tmp/pip.log"; exit 1
-fi
 # A wheel for this platform (it carries a compiled library), not a pure one.
 grep -q "filename=tcbench-.*-linux_[a-z0-9_]*\.whl" "$tmp/pip.log" || { echo "FAIL: not a platform wheel"; cat "$tmp/pip.log"; exit 1; }
 # ./python is not the way, and says so.
@@ -52,13 +30,7 @@ fi
 grep -qF "install from the repository root: \`pip install .\` there" "$tmp/pip_python.log" || { cat "$tmp/pip_python.log"; exit 1; }
 rm -rf "$tmp/src"
 
-# A sanitized library (TCB_SANITIZE) loads into python only after the ASan runtime.
-sanitizer_env=()
-if readelf -d "$TCB_BUILD_DIR/libtcbench.so" | grep -q 'NEEDED.*libasan'; then
-    sanitizer_env=(LD_PRELOAD="$("${CC:-gcc}" -print-file-name=libasan.so)" ASAN_OPTIONS=detect_leaks=0)
-fi
-# A fresh shell with the venv activated: its bin/ first on PATH.
-fresh() { (cd "$tmp/empty" && env -i PATH="$tmp/venv/bin:/usr/bin:/bin" HOME="$tmp/home" "${sanitizer_env[@]}" "$@"); }
+fresh() { in_venv "$tmp" "$tmp/empty" "$@"; }
 fresh python3 - "$tmp/venv" <<'PY'
 import os, sys
 import numpy as np
