@@ -63,9 +63,9 @@ static void write_twin_note(FILE *f, const tcb_rpt_block *b)
             fprintf(f,
                     "\n%s and %s agree on m_sL2 (%.2f and %.2f): with the same params (%s) they start from "
                     "the same weights and train on the same batches (the seed's streams), and differ only by "
-                    "mca's metric-consistency term (α_mc · L_mc, from the first iteration, no warm-up), which a "
-                    "short training leaves no time to act (preset tiny: 300 iterations; on synth/quadruped_walk "
-                    "the two were still within 0.2 %% after 3,000). The paper reports them apart after its full "
+                    "mca's metric-consistency term (α_mc · L_mc, from the first iteration, no warm-up), whose "
+                    "effect on the weights grows with the training: a short one leaves it no time to act (README, "
+                    "\"atlasnet and mca in the default benchmark\"). The paper reports them apart after its full "
                     "training (preset paper: 200,000 iterations).\n",
                     a->method, m->method, x, y, a->params);
         }
