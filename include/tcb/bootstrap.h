@@ -31,7 +31,15 @@
  * N(μ, 1), one seed per method: 93.85 % with 2 000 resamples each (94.00 %
  * with 10 000; 94.05 % at P = 100). The percentile interval of a mean
  * under-covers slightly at small P: it spreads by the plug-in variance,
- * biased low by (P − 1)/P, and by normal rather than t quantiles. */
+ * biased low by (P − 1)/P, and by normal rather than t quantiles.
+ *
+ * Across sequences (the MEAN rows): pass each sequence's seed- and
+ * pair-averaged value as one "pair", S_A = S_B = 1 (x_A[0][q] = A's mean on
+ * sequence q): the pair level then resamples sequences, paired. There are
+ * few sequences, and the percentile interval is then far too narrow:
+ * measured (2 000 problems, N(μ, 1) differences, 2 000 resamples) it covers
+ * 80 % with 4 sequences, 87 % with 6, 89 % with 8, 90 % with 10, 92 % with
+ * 17 — a report must say how many sequences a MEAN interval rests on. */
 #ifndef TCB_BOOTSTRAP_H
 #define TCB_BOOTSTRAP_H
 

@@ -89,6 +89,20 @@ static void test_estimate_and_draws(void **state)
     }
 }
 
+/* Across sequences: one value per sequence and method, the sequences the
+ * resampled units; the estimate is the mean of the per-sequence differences. */
+static void test_across_sequences(void **state)
+{
+    (void)state;
+    const double a[6] = {61.44, 12.5, 30.0, 8.25, 19.0, 44.0}, b[6] = {60.24, 12.0, 31.0, 8.0, 18.5, 43.0};
+    tcb_boot_result r;
+    tcb_error err = {0};
+    assert_int_equal(tcb_bootstrap_paired(a, 1, b, 1, 6, 0, "mean", 0, NULL, &r, &err), TCB_OK);
+    assert_near(r.estimate, (1.2 + 0.5 - 1.0 + 0.25 + 0.5 + 1.0) / 6, 1e-12);
+    /* the resample means lie between the least and the largest difference */
+    assert_true(-1.0 <= r.lo && r.lo < r.estimate && r.estimate < r.hi && r.hi <= 1.2 + 1e-12);
+}
+
 static void test_quantile_linear(void **state)
 {
     (void)state;
@@ -114,7 +128,9 @@ static void test_bad_input(void **state)
 }
 
 /* Coverage: N_PROBLEMS problems of COV_P paired differences N(μ, 1), one
- * seed per method; the 95 % interval must hold μ in 93–97 % of them. */
+ * seed per method; the 95 % interval must hold μ in 93–97 % of them
+ * (measured 93.85 %: the percentile interval under-covers a little at
+ * P = 50, see tcb/bootstrap.h). */
 enum { N_PROBLEMS = 2000, COV_P = 50, COV_R = 2000 };
 
 static void test_coverage(void **state)
@@ -146,7 +162,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_reproducible),     cmocka_unit_test(test_constant_difference),
-        cmocka_unit_test(test_estimate_and_draws), cmocka_unit_test(test_quantile_linear),
+        cmocka_unit_test(test_estimate_and_draws), cmocka_unit_test(test_across_sequences),
+        cmocka_unit_test(test_quantile_linear),
         cmocka_unit_test(test_bad_input),        cmocka_unit_test(test_coverage),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
