@@ -12,9 +12,9 @@
  *     3. P draws tcb_rng_below(P): the pairs, with replacement, the SAME
  *        pair indices for both methods (the comparison is paired).
  * Its value is the mean over the drawn pairs of (mean over the drawn A seeds
- * of x_A) − (mean over the drawn B seeds of x_B). A draw is made even when
- * S = 1 (it is always 0), so the stream does not depend on the seed counts'
- * being one.
+ * of x_A) − (mean over the drawn B seeds of x_B). The seed draws are made
+ * even when S = 1 (each is then 0): the order above holds for every count.
+ * tests/support/bootstrap_dump.c writes the draws for a numpy recomputation.
  *
  * With one seed per method the seed level is a no-op: the interval then
  * holds the variation over pairs only and leaves out the training variance
