@@ -106,6 +106,20 @@ void tcb_synth_humanoid_body(tcb_synth_body *b);
 void tcb_synth_humanoid_pose(const tcb_synth_body *b, const tcb_synth_gait *g, double phase,
                              tcb_synth_pose *p);
 
+/* The quadruped giving way: pose at collapse progress s ∈ [0, 1] (gait
+ * swing: leg splay, bend: leg fold, bounce: how far the body drops). */
+void tcb_synth_quadruped_collapse_pose(const tcb_synth_body *b, const tcb_synth_gait *g, double s,
+                                       tcb_synth_pose *p);
+
+/* ---- tcb_synth_collapse.c ------------------------------------------------ */
+/* out [nv][3] = rest with its flesh shrunk towards the skeleton by the
+ * collapse's share at progress `amount` ∈ [0, 1] (0: rest unchanged). */
+void tcb_synth_collapse_deflate(const tcb_synth_body *b, const tcb_synth_skin *s,
+                                const float *rest, double amount, float *out);
+/* In place on a posed frame: squash towards the ground, widen near it
+ * about centre (x, z), pile what sank below y = 0 into a thin soft layer. */
+void tcb_synth_collapse_sag(float *verts, int nv, const double centre[2], double amount);
+
 /* ---- synth.c ----------------------------------------------------------- */
 /* Rest mesh of the named sequence's body (seed-independent canonical
  * proportions), for tests; malloc'ed arrays owned by the caller. */

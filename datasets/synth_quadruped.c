@@ -75,3 +75,25 @@ void tcb_synth_quadruped_pose(const tcb_synth_body *b, const tcb_synth_gait *g, 
     tcb_synth_pose_rotate(p, b, TAIL, 0.1 * sin(c + 1.0), 0.3 * sin(c), 0.0);
     p->shift[1] = g->bounce * sin(2.0 * c);
 }
+
+/* The quadruped giving way (progress s from 0, standing, to 1, down): the
+ * legs splay outwards (gait `swing`, radians) and fold (`bend`), neck,
+ * head and tail droop, and the body drops by `bounce` (body-length units)
+ * to lie on the ground, so the feet sink through the floor and pile there
+ * (tcb_synth_collapse_sag). */
+void tcb_synth_quadruped_collapse_pose(const tcb_synth_body *b, const tcb_synth_gait *g, double s,
+                                       tcb_synth_pose *p)
+{
+    static const int uppers[] = {LF_UPPER, LF_UPPER + 1, LH_UPPER, LH_UPPER + 1};
+    for (int k = 0; k < 4; k++) {
+        /* Hind legs fold the other way (their knee points forward). */
+        double fold = (k < 2 ? -1.0 : 1.0) * g->bend * s;
+        tcb_synth_pose_rotate(p, b, uppers[k], 0.0, 0.0, g->swing * s);
+        tcb_synth_pose_rotate(p, b, uppers[k] + 2, fold, 0.0, 0.0);
+        tcb_synth_pose_rotate(p, b, uppers[k] + 4, -0.5 * fold, 0.0, 0.0);
+    }
+    tcb_synth_pose_rotate(p, b, NECK, -0.9 * s, 0.0, 0.0);
+    tcb_synth_pose_rotate(p, b, HEAD, -0.4 * s, 0.0, 0.0);
+    tcb_synth_pose_rotate(p, b, TAIL, 0.6 * s, 0.0, 0.0);
+    p->shift[1] = -g->bounce * s;
+}

@@ -322,4 +322,9 @@ typedef struct tcb_align_cmd {
 } tcb_align_cmd;
 int tcb_datasets_align(const char *dir, const tcb_align_cmd *a, tcb_error *err);
 
+/* `tcbench datasets distortion`: the per-frame non-isometry of a synthetic
+ * sequence (generated with seed and n_frames, ≤ 0: its default length) or
+ * of an OBJ directory, as a table on out. (harness/distortion_cmd.c) */
+int tcb_datasets_distortion(const char *what, uint64_t seed, int n_frames, FILE *out, tcb_error *err);
+
 #endif

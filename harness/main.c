@@ -338,16 +338,30 @@ static int datasets_align(const cli *c)
     return 0;
 }
 
+static int datasets_distortion(const cli *c)
+{
+    if (c->n_args != 2) return usage_error("datasets distortion", "missing %s", "NAME|DIR");
+    for (int f = 0; f < F_COUNT; f++)
+        if (f != F_PLUGIN && f != F_SEED && f != F_FRAMES && c->set[f])
+            return usage_error("datasets distortion", "%s does not apply", flags[f].name);
+    tcb_error err = {0};
+    if (tcb_datasets_distortion(c->arg[1], (uint64_t)flag_int(c, F_SEED, 0), (int)flag_int(c, F_FRAMES, 0),
+                                stdout, &err))
+        return fail(&err);
+    return 0;
+}
+
 static int cmd_datasets(const cli *c)
 {
     if (strcmp(c->arg[0], "align") == 0) return datasets_align(c);
+    if (strcmp(c->arg[0], "distortion") == 0) return datasets_distortion(c);
     if (c->n_args > 1) return usage_error("datasets", "unexpected argument '%s'", c->arg[1]);
     if (c->set[F_SAMPLES] || c->set[F_PLOT])
         return usage_error("datasets", "%s applies to 'datasets align' only",
                            c->set[F_SAMPLES] ? "--samples" : "--plot");
     if (strcmp(c->arg[0], "synth") == 0) return datasets_synth(c);
     if (strcmp(c->arg[0], "list") != 0)
-        return usage_error("datasets", "unknown action '%s' (expected list, synth or align)", c->arg[0]);
+        return usage_error("datasets", "unknown action '%s' (expected list, synth, align or distortion)", c->arg[0]);
     for (int f = 0; f < F_COUNT; f++)
         if (f != F_PLUGIN && c->set[f])
             return usage_error("datasets list", "%s applies to 'datasets synth' only", flags[f].name);
@@ -595,10 +609,11 @@ static const command commands[] = {
      "  tcbench methods --plugin build/examples/libmy_method.so\n"},
     {"datasets", cmd_datasets,
      BIT(F_OUT) | BIT(F_SEED) | BIT(F_FRAMES) | BIT(F_SEQUENCE) | BIT(F_SAMPLES) | BIT(F_PLOT), 1, 2,
-     "ACTION (list, synth or align)",
+     "ACTION (list, synth, align or distortion)",
      "usage: tcbench datasets list\n"
      "       tcbench datasets synth --out DIR [--seed N] [--frames N] [--sequence NAME]\n"
      "       tcbench datasets align DIR --out FILE [--samples N] [--seed N] [--plot PNG]\n"
+     "       tcbench datasets distortion NAME|DIR [--seed N] [--frames N]\n"
      "\n"
      "list:  the embedded synthetic sequences.\n"
      "synth: writes synthetic sequences as OBJ files, DIR/<name>/mesh_NNNN.obj\n"
@@ -607,6 +622,10 @@ static const command commands[] = {
      "       centred, turned about y by the multiple of 3 degrees that minimises the\n"
      "       Chamfer distance to the aligned previous frame; writes the angles per\n"
      "       frame as JSON (what a config's \"align_rotation\": true applies).\n"
+     "distortion: how far a synthetic sequence (NAME) or an OBJ directory is from\n"
+     "       isometric: per frame against frame 0, the mean and max relative change\n"
+     "       of edge lengths, the mean relative change of geodesic distances, the\n"
+     "       area ratio (raw coordinates).\n"
      "\n"
      "options:\n"
      "  --out DIR|FILE   output directory (synth) or rotations file (align); required\n"
@@ -619,7 +638,8 @@ static const command commands[] = {
      "\n"
      "examples:\n"
      "  tcbench datasets synth --out data/synth --sequence quadruped_walk\n"
-     "  tcbench datasets align ../shared/data/ama/crane --out crane-rotations.json --plot crane-yaw.png\n"},
+     "  tcbench datasets align ../shared/data/ama/crane --out crane-rotations.json --plot crane-yaw.png\n"
+     "  tcbench datasets distortion quadruped_collapse\n"},
     {"check", cmd_check, BIT(F_UPDATE), 2, 2, "RUN_DIR BASELINE",
      "usage: tcbench check RUN_DIR BASELINE [--update]\n"
      "\n"
