@@ -74,6 +74,14 @@ expect 0 "synth/quadruped_walk" "$TCBENCH" datasets synth --out synth --sequence
 [ "$(ls synth)" = "quadruped_walk" ] || { echo "FAIL: --sequence wrote $(ls synth)"; exit 1; }
 [ "$(ls synth/quadruped_walk | grep -c '^mesh_[0-9]*\.obj$')" -eq 3 ] ||
     { echo "FAIL: expected 3 OBJ frames"; ls synth/quadruped_walk; exit 1; }
+expect 0 "quadruped_collapse: 6 frames" "$TCBENCH" datasets distortion quadruped_collapse --frames 6
+# The collapse's last frame is far from isometric; the walk's is not.
+awk '$1 == 5 { exit !($4 + 0 > 5) }' out.txt || { echo "FAIL: collapse distortion"; cat out.txt; exit 1; }
+expect 0 "quadruped_walk" "$TCBENCH" datasets distortion synth/quadruped_walk
+awk '$1 == 2 { exit !($4 + 0 < 5) }' out.txt || { echo "FAIL: walk distortion"; cat out.txt; exit 1; }
+expect 2 "nope: neither a synthetic sequence" "$TCBENCH" datasets distortion nope
+expect 2 "datasets distortion: --out does not apply" "$TCBENCH" datasets distortion quadruped_walk --out x
+expect 2 "datasets distortion: missing NAME|DIR" "$TCBENCH" datasets distortion
 expect 0 "oracle" "$TCBENCH" methods
 grep -q "^nearest *built-in" out.txt || { echo "FAIL: methods table"; cat out.txt; exit 1; }
 

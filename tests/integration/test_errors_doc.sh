@@ -320,6 +320,7 @@ row "\`--threads x\`" run split.json --threads x
 row "a negative \`--seed\`" "$TCBENCH" inspect runs/split nearest 0 --seed -1
 row "\`--count 0\`" "$TCBENCH" frames runs/split nearest --count 0
 row "\`--samples 0\`" "$TCBENCH" datasets align data/quadruped_walk --out r.json --samples 0
+row "\`datasets distortion\` of neither a synthetic sequence nor a directory" "$TCBENCH" datasets distortion nowhere
 row "\`--lock-timeout 0\`" run split.json --lock-timeout 0
 row "a single-value flag given twice" "$TCBENCH" score split.json --dataset synth --sequence quadruped_walk --pred pred --pred other --name files
 row "\`--root\` naming a dataset twice" run split.json --root synth=a --root synth=b

@@ -22,7 +22,8 @@
 #define ISOMETRY_TOL  0.02 /* total area and mean edge length vs frame 0 (measured ≤ 0.4 %) */
 #define MIN_MOTION    0.05 /* max vertex displacement, frame 0 → K/2 (measured ≥ 0.15) */
 #define SYMMETRY_TOL  1e-5 /* mirror image to nearest vertex (measured ~1e-8) */
-/* The collapse's last frame against its first (measured at seed 5: ...). */
+/* The collapse's last frame against its first (measured at seed 5: edges 31.2 %,
+ * geodesics 19.8 %, area 0.709; the gaits stay under 5 %). */
 #define COLLAPSE_MIN_EDGE 0.25
 #define COLLAPSE_MIN_GEO  0.15
 #define COLLAPSE_MAX_AREA 0.8
