@@ -30,24 +30,33 @@ void tcb_adam_reset(tcb_adam *a)
     a->t = 0;
 }
 
-void tcb_adam_step(tcb_adam *a, float *params, const float *grads, double lr)
+void tcb_adam_step_groups(tcb_adam *a, float *params, const float *grads, const size_t *bounds,
+                          const double *lrs, int n_groups)
 {
     a->t++;
     /* The scalars in double as torch computes them in Python floats. */
     double bc1 = 1.0 - pow(a->b1, (double)a->t), bc2 = 1.0 - pow(a->b2, (double)a->t);
-    float step = (float)(lr / bc1), sbc2 = (float)sqrt(bc2), eps = (float)a->eps;
+    float sbc2 = (float)sqrt(bc2), eps = (float)a->eps;
     /* 1 − β in double, then rounded, as torch passes `1 - beta` to its kernel:
      * 1.0f − (float)β2 would be off by 4.7e-5 relative. */
     float b1 = (float)a->b1, b2 = (float)a->b2, c1 = (float)(1.0 - a->b1), c2 = (float)(1.0 - a->b2);
     float *m = a->m, *v = a->v;
-    size_t n = a->n;
+    for (int g = 0; g < n_groups; g++) {
+        float step = (float)(lrs[g] / bc1);
 #pragma omp parallel for schedule(static)
-    for (size_t k = 0; k < n; k++) {
-        float g = grads[k];
-        m[k] = b1 * m[k] + c1 * g;
-        v[k] = b2 * v[k] + c2 * g * g;
-        params[k] -= step * m[k] / (sqrtf(v[k]) / sbc2 + eps);
+        for (size_t k = bounds[g]; k < bounds[g + 1]; k++) {
+            float gr = grads[k];
+            m[k] = b1 * m[k] + c1 * gr;
+            v[k] = b2 * v[k] + c2 * gr * gr;
+            params[k] -= step * m[k] / (sqrtf(v[k]) / sbc2 + eps);
+        }
     }
+}
+
+void tcb_adam_step(tcb_adam *a, float *params, const float *grads, double lr)
+{
+    const size_t bounds[2] = {0, a->n};
+    tcb_adam_step_groups(a, params, grads, bounds, &lr, 1);
 }
 
 double tcb_lr_at(double lr0, long long it, long long total)

@@ -27,6 +27,12 @@ void tcb_adam_reset(tcb_adam *a);
  * v ← β2 v + (1−β2) g², p ← p − (lr / (1−β1^t)) · m / (√v / √(1−β2^t) + eps). */
 void tcb_adam_step(tcb_adam *a, float *params, const float *grads, double lr);
 
+/* The same update with parameter groups: group g is params[bounds[g] ..
+ * bounds[g + 1]) with learning rate lrs[g] (as one torch.optim.Adam per
+ * group stepping together: one step count). */
+void tcb_adam_step_groups(tcb_adam *a, float *params, const float *grads, const size_t *bounds,
+                          const double *lrs, int n_groups);
+
 /* The lr of iteration `it` (0-based) of `total`: lr0, ÷10 from iteration
  * ⌊0.8 total⌋, ÷100 from ⌊0.9 total⌋. The scheduler steps at the start of
  * each iteration, so iteration 160,000 of 200,000 already uses lr0/10. */

@@ -1,8 +1,11 @@
 #include "neural/layers.h"
 
 #include <cblas.h>
+#include <math.h>
 #include <stddef.h>
 #include <string.h>
+
+#include "tcb/rng.h"
 
 /* Dimensions up to this are "tiny": a GEMM with a 3-wide side spends its
  * time in packing and dispatch, a fused loop streams the other operand once. */
@@ -176,6 +179,26 @@ void tcb_relu_backward(float *dx, const float *dy, const float *y, int64_t n)
 {
 #pragma omp parallel for schedule(static) if ((double)n > PAR_MIN)
     for (int64_t i = 0; i < n; i++) dx[i] = y[i] > 0.0f ? dy[i] : 0.0f;
+}
+
+void tcb_linear_init_uniform(const tcb_linear *l, tcb_rng *rng)
+{
+    double bound = 1.0 / sqrt((double)l->in);
+    size_t nw = (size_t)l->in * (size_t)l->out;
+    for (size_t i = 0; i < nw; i++) l->W[i] = (float)((2.0 * tcb_rng_uniform(rng) - 1.0) * bound);
+    for (int i = 0; i < l->out; i++) l->b[i] = (float)((2.0 * tcb_rng_uniform(rng) - 1.0) * bound);
+}
+
+void tcb_leaky_relu_forward(float *y, const float *x, int64_t n, float slope)
+{
+#pragma omp parallel for schedule(static) if ((double)n > PAR_MIN)
+    for (int64_t i = 0; i < n; i++) y[i] = x[i] > 0.0f ? x[i] : slope * x[i];
+}
+
+void tcb_leaky_relu_backward(float *dx, const float *dy, const float *y, int64_t n, float slope)
+{
+#pragma omp parallel for schedule(static) if ((double)n > PAR_MIN)
+    for (int64_t i = 0; i < n; i++) dx[i] = y[i] > 0.0f ? dy[i] : slope * dy[i];
 }
 
 /* The elementwise loops run over CHUNK columns at a time so σ and σ′ of the

@@ -33,6 +33,11 @@ typedef struct tcb_linear {
 /* Views l at base + *offset and advances *offset by its in·out + out floats. */
 void tcb_linear_bind(tcb_linear *l, float *base, size_t *offset, int in, int out);
 
+/* PyTorch's default initialisation of a Linear layer: W then b, each entry
+ * U(−1/√in, 1/√in), drawn in that order from rng. */
+struct tcb_rng;
+void tcb_linear_init_uniform(const tcb_linear *l, struct tcb_rng *rng);
+
 /* y[(1+nt)·n][out] = x[(1+nt)·n][in] · W[out][in]ᵀ, plus b[out] on the n value
  * rows (PyTorch's Linear layout; b may be NULL). Tiny dimensions (in or out
  * ≤ 3: the xyz input, the xyz output) use fused loops, the rest cblas_sgemm. */
@@ -49,6 +54,14 @@ void tcb_relu_forward(float *y, const float *x, int64_t n);
 
 /* dx[n] = dy · [y > 0] from the forward output y; dx may alias dy. */
 void tcb_relu_backward(float *dx, const float *dy, const float *y, int64_t n);
+
+/* y[n] = x > 0 ? x : slope·x (PyTorch's LeakyReLU, slope 0.01 by default);
+ * y may alias x. */
+void tcb_leaky_relu_forward(float *y, const float *x, int64_t n, float slope);
+
+/* dx[n] = dy · (y > 0 ? 1 : slope) from the forward output y (slope > 0:
+ * y > 0 exactly where x > 0); dx may alias dy. */
+void tcb_leaky_relu_backward(float *dx, const float *dy, const float *y, int64_t n, float slope);
 
 /* Stacked softplus: x = [s; t_1..t_nt] (pre-activations and their tangents,
  * [(1+nt)·n][d]) → y = [softplus(s); σ(s)⊙t_1; …; σ(s)⊙t_nt]. */

@@ -1,5 +1,6 @@
 #include "neural/train_loop.h"
 
+#include <math.h>
 #include <omp.h>
 #include <stdio.h>
 
@@ -80,5 +81,19 @@ int tcb_train_loop_run(const tcb_train_loop *loop, const tcb_fit_ctx *ctx, tcb_e
     int rc = run(loop, ctx, err);
     omp_set_num_threads(prev_threads);
     if (rc) tcb_error_prefix(err, "%s: ", loop->name);
+    return rc;
+}
+
+int tcb_train_guard(const char *name, long long it, double loss, const float *grads, size_t n,
+                    double divergence, double *loss0, tcb_error *err)
+{
+    int rc = TCB_OK;
+    for (size_t k = 0; k < n && !rc; k++)
+        if (!isfinite(grads[k])) rc = tcb_fail(err, TCB_ERR_NUMERIC, "%s: non-finite gradient", name);
+    if (!rc && it == 0) *loss0 = loss;
+    if (!rc && divergence > 0 && loss > divergence * *loss0)
+        rc = tcb_fail(err, TCB_ERR_NUMERIC, "%s: diverged, loss %g > %g x the first iteration's %g", name,
+                      loss, divergence, *loss0);
+    if (rc) tcb_error_prefix(err, "iteration %lld: ", it);
     return rc;
 }

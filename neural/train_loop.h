@@ -29,6 +29,15 @@ typedef struct tcb_train_loop {
     int (*load)(void *trainer, const char *path, double *seconds, tcb_error *err);
 } tcb_train_loop;
 
+/* What every trainer checks after computing a step's loss and gradient,
+ * before it updates: the gradient is finite, the first iteration's loss is
+ * remembered (*loss0 at it = 0), and a loss beyond divergence × *loss0
+ * (divergence > 0) is a divergence. Errors (TCB_ERR_NUMERIC, "iteration N:
+ * NAME: non-finite gradient" / "… diverged, loss …") end the cell as
+ * diverged. */
+int tcb_train_guard(const char *name, long long it, double loss, const float *grads, size_t n,
+                    double divergence, double *loss0, tcb_error *err);
+
 /* Runs the loop with ctx->n_threads OpenMP threads (OpenBLAS's OpenMP
  * build follows them; the caller's setting is restored afterwards) and sets
  * *ctx->resumed_fit_s to the seconds a resumed checkpoint had cost. Errors

@@ -101,11 +101,7 @@ void tcb_atlas_model_free(tcb_atlas_model *m)
 void tcb_atlas_model_init(tcb_atlas_model *m, tcb_rng *rng)
 {
     for (int k = 0; k < layer_count(m->P); k++) {
-        tcb_linear *l = layer_view(&m->enc, m->dec, k);
-        double bound = 1.0 / sqrt((double)l->in);
-        size_t nw = (size_t)l->in * l->out;
-        for (size_t i = 0; i < nw; i++) l->W[i] = (float)((2.0 * tcb_rng_uniform(rng) - 1.0) * bound);
-        for (int i = 0; i < l->out; i++) l->b[i] = (float)((2.0 * tcb_rng_uniform(rng) - 1.0) * bound);
+        tcb_linear_init_uniform(layer_view(&m->enc, m->dec, k), rng);
     }
 }
 

@@ -7,6 +7,7 @@
 #include "methods/atlas/loss_chamfer.h"
 #include "methods/atlas/loss_dsr.h"
 #include "methods/atlas/loss_metric.h"
+#include "neural/train_loop.h"
 #include "tcb/split.h"
 
 static int uses_tangents(const tcb_atlas_train_cfg *c) { return c->loss != TCB_ATLAS_LOSS_CHAMFER; }
@@ -108,13 +109,6 @@ static int loss_and_grad(tcb_atlas_trainer *t, double *loss, tcb_error *err)
     return rc;
 }
 
-static int grads_finite(const tcb_atlas_model *m)
-{
-    for (size_t k = 0; k < m->nparams; k++)
-        if (!isfinite(m->grads[k])) return 0;
-    return 1;
-}
-
 int tcb_atlas_train_step(tcb_atlas_trainer *t, const tcb_sequence *seq, double *loss, tcb_error *err)
 {
     int tan = uses_tangents(&t->cfg);
@@ -128,16 +122,12 @@ int tcb_atlas_train_step(tcb_atlas_trainer *t, const tcb_sequence *seq, double *
         rc = tcb_atlas_model_backward(t->model, t->work, t->dphi, tan ? t->dphi_u : NULL,
                                       tan ? t->dphi_v : NULL, err);
     }
-    if (!rc && !grads_finite(t->model))
-        rc = tcb_fail(err, TCB_ERR_NUMERIC, "atlas: non-finite gradient");
-    if (!rc && t->it == 0) t->loss0 = *loss;
-    if (!rc && t->cfg.divergence > 0 && *loss > t->cfg.divergence * t->loss0)
-        rc = tcb_fail(err, TCB_ERR_NUMERIC, "atlas: diverged, loss %g > %g x the first iteration's %g", *loss,
-                      t->cfg.divergence, t->loss0);
-    if (rc) {
+    if (!rc)
+        rc = tcb_train_guard("atlas", t->it, *loss, t->model->grads, t->model->nparams, t->cfg.divergence,
+                             &t->loss0, err);
+    else
         tcb_error_prefix(err, "iteration %lld: ", t->it);
-        return rc;
-    }
+    if (rc) return rc;
     tcb_adam_step(&t->adam, t->model->params, t->model->grads,
                         tcb_lr_at(t->cfg.lr, t->it, t->cfg.iterations));
     t->it++;

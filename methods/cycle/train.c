@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "neural/train_loop.h"
+
 /* Network call k deforms cloud x towards cloud y: encoder 0 encodes x,
  * encoder 1 encodes y. Calls 0..5 are the pairs of tcb_cc_pairs (the CC
  * code's triplet_chamfer_loss order), 6 and 7 the self-reconstruction
@@ -192,13 +194,6 @@ static void backward(tcb_cc_trainer *t, int n_calls)
                                         t->dz[e][c]);
 }
 
-static int grads_finite(const tcb_cc_net *n)
-{
-    for (size_t k = 0; k < n->nparams; k++)
-        if (!isfinite(n->grads[k])) return 0;
-    return 1;
-}
-
 int tcb_cc_train_step(tcb_cc_trainer *t, const tcb_sequence *seq, double *loss, tcb_error *err)
 {
     int n_calls = in_warmup(t) ? TCB_CC_CALLS : TCB_CC_PAIRS;
@@ -210,16 +205,12 @@ int tcb_cc_train_step(tcb_cc_trainer *t, const tcb_sequence *seq, double *loss, 
     if (!rc) {
         *loss = t->last.total;
         backward(t, n_calls);
-        if (!grads_finite(t->net)) rc = tcb_fail(err, TCB_ERR_NUMERIC, "cc: non-finite gradient");
-    }
-    if (!rc && t->it == 0) t->loss0 = *loss;
-    if (!rc && t->cfg.divergence > 0 && *loss > t->cfg.divergence * t->loss0)
-        rc = tcb_fail(err, TCB_ERR_NUMERIC, "cc: diverged, loss %g > %g x the first iteration's %g", *loss,
-                      t->cfg.divergence, t->loss0);
-    if (rc) {
+        rc = tcb_train_guard("cc", t->it, *loss, t->net->grads, t->net->nparams, t->cfg.divergence,
+                             &t->loss0, err);
+    } else {
         tcb_error_prefix(err, "iteration %lld: ", t->it);
-        return rc;
     }
+    if (rc) return rc;
     double lr = tcb_lr_at(t->cfg.lr, t->it, t->cfg.iterations);
     /* the CC code recreates Adam at each decay (learning_rate_scheduler) */
     if (t->it > 0 && lr != tcb_lr_at(t->cfg.lr, t->it - 1, t->cfg.iterations)) tcb_adam_reset(&t->adam);

@@ -1,0 +1,134 @@
+/* neural/lattice.c against a double-precision reference written here from
+ * PyTorch's grid_sample(align_corners=True, padding_mode="border") rules:
+ * values at the nodes, linear functions reproduced exactly, the border
+ * clamp, and the backward checked by central differences of the
+ * reference objective ℓ = Σ a·out (and as the forward's adjoint). */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "neural/lattice.h"
+#include "tcb/rng.h"
+#include "testutil.h"
+
+#define FD_H 1e-6
+
+/* The reference sample of one point, in double, from the rules: u = (p+1)/2·(r−1)
+ * clamped to [0, r−1]; the corners floor(u), floor(u)+1, a corner past the
+ * last node weighing nothing. */
+static void ref_sample(const double *values, int r, int F, const float p[3], double *out)
+{
+    double u[3];
+    int i0[3];
+    for (int a = 0; a < 3; a++) {
+        u[a] = fmin(fmax(((double)p[a] + 1.0) * 0.5 * (r - 1), 0.0), r - 1.0);
+        i0[a] = (int)floor(u[a]);
+    }
+    for (int f = 0; f < F; f++) out[f] = 0.0;
+    for (int c = 0; c < 8; c++) {
+        int idx[3] = {i0[0] + (c & 1), i0[1] + ((c >> 1) & 1), i0[2] + (c >> 2)};
+        double w = 1.0;
+        for (int a = 0; a < 3; a++) w *= (idx[a] == i0[a]) ? 1.0 - (u[a] - i0[a]) : u[a] - i0[a];
+        if (idx[0] >= r || idx[1] >= r || idx[2] >= r) continue;
+        const double *v = values + ((size_t)(idx[2] * r + idx[1]) * r + idx[0]) * F;
+        for (int f = 0; f < F; f++) out[f] += w * v[f];
+    }
+}
+
+static double ref_objective(const double *values, int r, int F, const float *pts, int n,
+                            const double *a)
+{
+    double l = 0.0, out[8];
+    for (int p = 0; p < n; p++) {
+        ref_sample(values, r, F, pts + 3 * p, out);
+        for (int f = 0; f < F; f++) l += a[p * F + f] * out[f];
+    }
+    return l;
+}
+
+enum { R = 5, F = 3, N = 40 };
+
+static void random_case(tcb_rng *rng, float *values, float *pts)
+{
+    tu_fill_uniform(rng, values, (size_t)R * R * R * F, -1.0, 1.0);
+    /* Inside the cube, outside it (the border clamp), and exactly on nodes. */
+    tu_fill_uniform(rng, pts, 3 * (N - 8), -1.3, 1.3);
+    for (int p = N - 8; p < N; p++)
+        for (int a = 0; a < 3; a++) pts[3 * p + a] = -1.0f + 0.5f * (float)((p + a) % R);
+}
+
+static void test_forward_matches_reference(void **state)
+{
+    (void)state;
+    tcb_rng rng;
+    tcb_rng_seed_stream(&rng, 1, "lattice");
+    float values[R * R * R * F], pts[3 * N], out[N * F] = {0};
+    random_case(&rng, values, pts);
+    tcb_lattice_forward(out, values, R, F, pts, N, 0.5f);
+    double *vd = tu_to_double(values, R * R * R * F), ref[F];
+    for (int p = 0; p < N; p++) {
+        ref_sample(vd, R, F, pts + 3 * p, ref);
+        for (int f = 0; f < F; f++) assert_near(out[p * F + f], 0.5 * ref[f], 1e-6);
+    }
+    free(vd);
+}
+
+/* Node values of a linear function are interpolated to that function,
+ * clamped to the cube outside it. */
+static void test_linear_exact(void **state)
+{
+    (void)state;
+    float values[R * R * R], pts[3] = {0.3f, -0.71f, 1.6f}, out = 0.0f;
+    for (int z = 0; z < R; z++)
+        for (int y = 0; y < R; y++)
+            for (int x = 0; x < R; x++) {
+                double px = -1.0 + 2.0 * x / (R - 1), py = -1.0 + 2.0 * y / (R - 1),
+                       pz = -1.0 + 2.0 * z / (R - 1);
+                values[(z * R + y) * R + x] = (float)(2.0 * px - py + 0.5 * pz + 0.25);
+            }
+    tcb_lattice_forward(&out, values, R, 1, pts, 1, 1.0f);
+    assert_near(out, 2.0 * 0.3 + 0.71 + 0.5 * 1.0 + 0.25, 1e-6);
+}
+
+static void test_backward(void **state)
+{
+    (void)state;
+    tcb_rng rng;
+    tcb_rng_seed_stream(&rng, 2, "lattice");
+    float values[R * R * R * F], pts[3 * N], dout[N * F], grad[R * R * R * F] = {0};
+    random_case(&rng, values, pts);
+    tu_fill_uniform(&rng, dout, N * F, -1.0, 1.0);
+    tcb_lattice_backward(grad, dout, R, F, pts, N, 0.5f);
+    double *vd = tu_to_double(values, R * R * R * F), *ad = tu_to_double(dout, N * F);
+    for (int e = 0; e < R * R * R * F; e++) {
+        double keep = vd[e];
+        vd[e] = keep + FD_H;
+        double lp = ref_objective(vd, R, F, pts, N, ad);
+        vd[e] = keep - FD_H;
+        double lm = ref_objective(vd, R, F, pts, N, ad);
+        vd[e] = keep;
+        assert_near(grad[e], 0.5 * (lp - lm) / (2.0 * FD_H), 1e-5);
+    }
+    /* The adjoint identity <dout, S v> = <Sᵀ dout, v>. */
+    float out[N * F] = {0};
+    tcb_lattice_forward(out, values, R, F, pts, N, 0.5f);
+    double lhs = 0.0, rhs = 0.0;
+    for (int e = 0; e < N * F; e++) lhs += (double)dout[e] * out[e];
+    for (int e = 0; e < R * R * R * F; e++) rhs += (double)grad[e] * values[e];
+    assert_near(lhs, rhs, 1e-4);
+    free(vd);
+    free(ad);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_forward_matches_reference),
+                                       cmocka_unit_test(test_linear_exact),
+                                       cmocka_unit_test(test_backward)};
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
