@@ -242,7 +242,9 @@ static int cmd_status(const cli *c)
     }
     int rc = load_config(&resolved, &cfg);
     if (rc) return rc;
-    tcb_run_opts opts = {.output = resolved.value[F_OUT]};
+    tcb_term_progress tp; /* warnings only (squeue's failure) */
+    tcb_term_progress_init(&tp, stderr, 1);
+    tcb_run_opts opts = {.output = resolved.value[F_OUT], .reporter = tcb_term_progress_reporter(&tp)};
     rc = tcb_run_status(&cfg, &opts, stdout, &err);
     tcb_config_free(&cfg);
     return rc ? fail(&err) : 0;
