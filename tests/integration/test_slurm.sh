@@ -48,9 +48,10 @@ sed 's/"iterations": 100/"iterations": 800/; s/"seeds": \[0, 1\]/"seeds": [0, 1,
 # The uninterrupted cells, by two local runs sharing the cells, meanwhile.
 refs=()
 for _ in 1 2; do "$TCBENCH" run long.json --out plain-long --quiet 2> /dev/null & refs+=($!); done
-TCBENCH="$TCBENCH" "$TCB_SOURCE_DIR/scripts/slurm/submit.sh" long.json --out "$tmp/long" \
+TCBENCH="$TCBENCH" "$TCB_SOURCE_DIR/scripts/slurm/submit.sh" long.json --out "$tmp/long" --max-running 3 \
     --sbatch "-c 1 -o $tmp/long-%a.log" > submit-long.txt 2>&1 || { cat submit-long.txt; exit 1; }
 job=$(sed -n 's/^Submitted batch job \([0-9]*\)$/\1/p' submit-long.txt)
+scontrol show job "$job" | grep -q "ArrayTaskThrottle=3" || { echo "FAIL: --max-running"; scontrol show job "$job"; exit 1; }
 cell() { echo "long/cells/synth/quadruped_walk/mca/seed_$(($1 - 1)).json"; } # cell ID's file
 fail() { echo "FAIL: $1"; cat long-*.log; squeue; exit 1; }
 # training ID: wait until cell ID's task holds its lock and is into the training.
