@@ -66,7 +66,7 @@ if [ "$tasks" -gt 0 ]; then
     exec sbatch $sbatch_args --array="0-$((tasks - 1))$throttle" --comment="tcbench shards=$tasks run=$run_dir" \
         --export=ALL,TCBENCH_SHARD=1 "$here/tcbench-array.sbatch" "$config" "${run_args[@]}"
 fi
-last=$(sed 's/.*[,-]//' <<< "$array")
+last=${array##*[,-]} # the largest id
 max=$(scontrol show config 2> /dev/null | sed -n 's/^MaxArraySize *= *\([0-9]*\).*/\1/p')
 if [ -n "$max" ] && [ "$last" -ge "$max" ]; then
     echo "submit.sh: cell $last is past this cluster's MaxArraySize ($max: array indices 0-$((max - 1))), and a task's index is its cell id; use --tasks N (N <= $max), each task running the cells whose id is its index modulo N" >&2
