@@ -108,6 +108,20 @@ void tcb_cell_lock_release(tcb_cell_lock *l);
 /* The holder of the cell at cell_path: 0, or -1 when it has no lock. */
 int tcb_cell_lock_holder(const char *cell_path, tcb_lock_info *info);
 
+/* The cells of a run directory that Slurm has queued (pending or running
+ * array tasks submitted by scripts/slurm/submit.sh), from squeue
+ * (harness/slurm_queue.c). Without squeue, or with no such directory, an
+ * empty queue; when squeue fails, an empty queue and a one-line note. -1
+ * only when out of memory. Free with tcb_slurm_queue_free. */
+typedef struct tcb_slurm_queue {
+    unsigned char *queued; /* [n_cells] 1: a queued task will run the cell */
+    int n_cells;
+    int asked;             /* squeue answered */
+    char jobs[256];        /* the array job ids of those tasks, "57 58" */
+} tcb_slurm_queue;
+int tcb_slurm_queue_read(const char *run_dir, int n_cells, tcb_slurm_queue *q, char *note, size_t note_size);
+void tcb_slurm_queue_free(tcb_slurm_queue *q);
+
 /* SIGTERM / SIGUSR1 as a stop request (harness/stop_signals.c): start
  * blocks them in the calling thread (call it before any other thread
  * exists) and starts the thread that waits for them; requested() is the

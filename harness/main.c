@@ -242,7 +242,9 @@ static int cmd_status(const cli *c)
     }
     int rc = load_config(&resolved, &cfg);
     if (rc) return rc;
-    tcb_run_opts opts = {.output = resolved.value[F_OUT]};
+    tcb_term_progress tp; /* warnings only (squeue's failure) */
+    tcb_term_progress_init(&tp, stderr, 1);
+    tcb_run_opts opts = {.output = resolved.value[F_OUT], .reporter = tcb_term_progress_reporter(&tp)};
     rc = tcb_run_status(&cfg, &opts, stdout, &err);
     tcb_config_free(&cfg);
     return rc ? fail(&err) : 0;
@@ -562,8 +564,10 @@ static const command commands[] = {
      "\n"
      "Where a run stands: the running cells (host, pid, heartbeat age), the failed\n"
      "and diverged ones with their messages, the count per state, and the ids of\n"
-     "the missing cells as a Slurm --array list to resubmit. A run directory is\n"
-     "read through the config it saved (RUN_DIR/config.json).\n"
+     "the missing cells as a Slurm --array list to resubmit. Cells whose array\n"
+     "tasks squeue lists as pending or running (jobs of scripts/slurm/submit.sh,\n"
+     "whose comment names the run directory) count as queued, not missing. A run\n"
+     "directory is read through the config it saved (RUN_DIR/config.json).\n"
      "\n"
      "options:\n"
      "  --variant NAME  with a CONFIG: its variant (default: the first)\n"

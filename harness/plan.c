@@ -203,27 +203,41 @@ int tcb_run_list_cells(const tcb_config *cfg, const tcb_run_opts *opts, FILE *ou
 
 /* ---- tcbench status ---------------------------------------------------- */
 
+/* Ids in Slurm's --array syntax ("0-3,7"), built in increasing order. */
+typedef struct id_ranges {
+    int lo, hi; /* the current run of ids, -1: none */
+    char text[4096];
+} id_ranges;
+
 typedef struct status_walk {
     FILE *out;
     const char *run_dir;
-    int n_done, n_diverged, n_failed, n_running, n_missing;
-    int range_lo, range_hi;    /* the current run of ids to resubmit, -1: none */
-    char array[4096];          /* the ids a run would compute (missing, failed) as Slurm's --array list */
+    const tcb_slurm_queue *queue;
+    int n_done, n_diverged, n_failed, n_running, n_missing, n_queued;
+    id_ranges resubmit; /* the ids a run would compute (missing, failed, not queued) */
+    id_ranges queued;
     char failures[8192];
 } status_walk;
 
-static void flush_range(status_walk *w)
+static void flush_range(id_ranges *r)
 {
-    if (w->range_lo < 0) return;
-    const char *sep = w->array[0] ? "," : "";
-    size_t used = strlen(w->array);
-    if (w->range_lo == w->range_hi) snprintf(w->array + used, sizeof w->array - used, "%s%d", sep, w->range_lo);
-    else snprintf(w->array + used, sizeof w->array - used, "%s%d-%d", sep, w->range_lo, w->range_hi);
-    w->range_lo = w->range_hi = -1;
+    if (r->lo < 0) return;
+    const char *sep = r->text[0] ? "," : "";
+    size_t used = strlen(r->text);
+    if (r->lo == r->hi) snprintf(r->text + used, sizeof r->text - used, "%s%d", sep, r->lo);
+    else snprintf(r->text + used, sizeof r->text - used, "%s%d-%d", sep, r->lo, r->hi);
+    r->lo = r->hi = -1;
+}
+
+static void add_id(id_ranges *r, int id)
+{
+    if (r->hi >= 0 && id == r->hi + 1) r->hi = id;
+    else flush_range(r), r->lo = r->hi = id;
 }
 
 /* A diverged cell is a result (listed, with why); a failed one has none
- * and is computed again by the next run, as a missing one is. */
+ * and is computed again by the next run, as a missing one is, unless a
+ * Slurm task that will run it is queued. */
 static int status_cell(void *ctx, const tcb_grid_cell *c)
 {
     status_walk *w = ctx;
@@ -231,37 +245,50 @@ static int status_cell(void *ctx, const tcb_grid_cell *c)
     cell_state_message(w->run_dir, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state, msg,
                        sizeof msg);
     int missing = !strcmp(state, "missing") || !strcmp(state, "unreadable"), failed = !strcmp(state, "failed");
+    int queued = (missing || failed) && w->queue->queued && w->queue->queued[c->id];
     if (!strcmp(state, "done")) w->n_done++;
     else if (!strncmp(state, "running", 7)) {
         w->n_running++;
         fprintf(w->out, "running  %5d  %s/%s/%s seed %d: %s\n", c->id, c->dataset->name, c->sequence->name,
                 c->method->label, c->seed, state + 8);
     } else if (!missing) {
-        w->n_failed += failed;
+        w->n_failed += failed && !queued;
         w->n_diverged += !failed;
         size_t used = strlen(w->failures);
-        snprintf(w->failures + used, sizeof w->failures - used, "%-8s %5d  %s/%s/%s seed %d: %s\n", state, c->id,
-                 c->dataset->name, c->sequence->name, c->method->label, c->seed, msg);
+        snprintf(w->failures + used, sizeof w->failures - used, "%-8s %5d  %s/%s/%s seed %d: %s%s\n", state, c->id,
+                 c->dataset->name, c->sequence->name, c->method->label, c->seed, msg,
+                 queued ? " (queued again in Slurm)" : "");
     }
-    w->n_missing += missing;
-    if (missing || failed) {
-        if (w->range_hi >= 0 && c->id == w->range_hi + 1) w->range_hi = c->id;
-        else flush_range(w), w->range_lo = w->range_hi = c->id;
-    }
+    w->n_missing += missing && !queued;
+    w->n_queued += queued;
+    if (queued) add_id(&w->queued, c->id);
+    else if (missing || failed) add_id(&w->resubmit, c->id);
     return TCB_OK;
 }
 
 int tcb_run_status(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_error *err)
 {
-    (void)err;
-    status_walk w = {.out = out, .run_dir = opts->output ? opts->output : cfg->output, .range_lo = -1, .range_hi = -1};
+    const char *run_dir = opts->output ? opts->output : cfg->output;
+    tcb_slurm_queue queue;
+    char note[640];
+    if (tcb_slurm_queue_read(run_dir, tcb_grid_count(cfg), &queue, note, sizeof note))
+        return tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
+    if (note[0]) tcb_report_log(&opts->reporter, TCB_LOG_WARN, "%s", note);
+    status_walk w = {.out = out, .run_dir = run_dir, .queue = &queue, .resubmit = {-1, -1, ""}, .queued = {-1, -1, ""}};
     tcb_grid_for_each(cfg, status_cell, &w);
-    flush_range(&w);
+    flush_range(&w.resubmit);
+    flush_range(&w.queued);
     fputs(w.failures, out);
-    fprintf(out, "%s: %d cells: %d done, %d diverged, %d failed, %d running, %d missing\n", w.run_dir,
+    if (w.n_queued)
+        fprintf(out, "queued   %s: pending or running in Slurm (%s %s)\n", w.queued.text,
+                strchr(queue.jobs, ' ') ? "jobs" : "job", queue.jobs);
+    fprintf(out, "%s: %d cells: %d done, %d diverged, %d failed, %d running, %d missing", w.run_dir,
             tcb_grid_count(cfg), w.n_done, w.n_diverged, w.n_failed, w.n_running, w.n_missing);
+    if (queue.asked) fprintf(out, ", %d queued in Slurm", w.n_queued);
+    fprintf(out, "\n");
     if (w.n_missing || w.n_failed)
         fprintf(out, "resubmit the cells a run computes (%d missing, %d failed): --array=%s\n", w.n_missing,
-                w.n_failed, w.array);
+                w.n_failed, w.resubmit.text);
+    tcb_slurm_queue_free(&queue);
     return TCB_OK;
 }

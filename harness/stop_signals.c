@@ -18,9 +18,11 @@ static void *wait_for_signal(void *arg)
         int sig = 0;
         if (sigwait(&s->set, &sig)) continue;
         if (atomic_load(&s->closing)) return NULL;
-        atomic_store(&s->signal, sig);
-        fprintf(stderr, "tcbench: %s received: stopping at the next safe point and saving the state\n",
-                sig == SIGTERM ? "SIGTERM" : "SIGUSR1");
+        /* Said once: a stop often comes twice (Slurm's scancel signals the
+         * job step and the batch shell, which passes its own on). */
+        if (!atomic_exchange(&s->signal, sig))
+            fprintf(stderr, "tcbench: %s received: stopping at the next safe point and saving the state\n",
+                    sig == SIGTERM ? "SIGTERM" : "SIGUSR1");
     }
 }
 

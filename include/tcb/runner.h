@@ -89,7 +89,10 @@ int tcb_run_list_cells(const tcb_config *cfg, const tcb_run_opts *opts, FILE *ou
 
 /* `tcbench status`: the running cells (host, pid, heartbeat age), the failed
  * ones with their messages, the count per state, and the missing ids as a
- * Slurm --array list ("0-3,7"). */
+ * Slurm --array list ("0-3,7"). Cells that Slurm array tasks submitted for
+ * this run directory will run (squeue, harness/slurm_queue.c) count as
+ * queued and stay out of that list; squeue's failure is a warning through
+ * opts->reporter. */
 int tcb_run_status(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_error *err);
 
 #ifdef __cplusplus

@@ -1,6 +1,14 @@
+#!/usr/bin/env bash
 # A one-node Slurm on this machine, for trying the cluster path without a
 # cluster (and for tests/integration/test_slurm.sh and bench/slurm_vs_local.sh).
-# Source it, then:
+# As a command:
+#   scripts/slurm/local-cluster.sh start [DIR [CPUS]]  starts it (DIR default
+#       /tmp/tcbench-slurm, CPUS default all), prints the export to run
+#   scripts/slurm/local-cluster.sh env [DIR]   prints `export SLURM_CONF=...`:
+#       eval "$(scripts/slurm/local-cluster.sh env)"
+#   scripts/slurm/local-cluster.sh stop [DIR]  stops it
+#   scripts/slurm/local-cluster.sh --help
+# Sourced, it defines:
 #   slurm_local_start DIR CPUS   starts munged (as the munge user, socket in
 #                                DIR), slurmctld and slurmd with a config
 #                                written to DIR/slurm.conf, waits for the node
@@ -8,6 +16,7 @@
 #                                why and returns 1 (what did start keeps
 #                                running: call slurm_local_stop)
 #   slurm_local_stop DIR         stops the three daemons (TERM, then KILL)
+#   slurm_local_missing          prints what is missing and returns 0, or 1
 # Needs root and Debian's slurm-wlm and munge (Slurm 22.05): SlurmUser=root,
 # proctrack/linuxproc and task/none so that no systemd or cgroup is needed.
 # DIR must be readable by the munge user (mode 755).
@@ -70,12 +79,46 @@ CONF
 }
 
 slurm_local_stop() {
-    local dir=${1:?slurm_local_stop DIR} f
+    local dir=${1:?slurm_local_stop DIR} f pids=()
+    # Its jobs first: slurmd waits for their steps before it exits.
+    if [ -s "$dir/slurmctld.pid" ]; then
+        SLURM_CONF="$dir/slurm.conf" scancel --me --full --signal=KILL 2> /dev/null
+        SLURM_CONF="$dir/slurm.conf" scancel --me 2> /dev/null
+        for _ in $(seq 20); do [ -z "$(SLURM_CONF="$dir/slurm.conf" squeue -h 2> /dev/null)" ] && break; sleep 0.25; done
+    fi
     for f in "$dir/slurmd.pid" "$dir/slurmctld.pid" "$dir/munge/pid"; do
-        [ -s "$f" ] && kill "$(cat "$f")" 2> /dev/null || true
+        [ -s "$f" ] && pids+=("$(cat "$f")")
     done
+    [ ${#pids[@]} -gt 0 ] || return 0
+    kill "${pids[@]}" 2> /dev/null
     sleep 1
-    for f in "$dir/slurmd.pid" "$dir/slurmctld.pid" "$dir/munge/pid"; do
-        [ -s "$f" ] && kill -9 "$(cat "$f")" 2> /dev/null || true
-    done
+    kill -9 "${pids[@]}" 2> /dev/null || true
 }
+
+# The command: start, env, stop, --help (only when run, not when sourced).
+slurm_local_main() {
+    local cmd=${1:---help} dir=${2:-/tmp/tcbench-slurm}
+    case "$cmd" in
+        start)
+            local why
+            if why=$(slurm_local_missing); then echo "local-cluster.sh: $why" >&2; return 1; fi
+            [ -e "$dir/slurmctld.pid" ] && kill -0 "$(cat "$dir/slurmctld.pid")" 2> /dev/null &&
+                { echo "local-cluster.sh: already running in $dir (local-cluster.sh stop $dir)" >&2; return 1; }
+            mkdir -p "$dir" && chmod 755 "$dir"
+            why=$(slurm_local_start "$dir" "${3:-$(nproc)}") ||
+                { echo "local-cluster.sh: $why (local-cluster.sh stop $dir stops what did start)" >&2; return 1; }
+            echo "a one-node Slurm runs in $dir; for sbatch, squeue and scancel:"
+            echo "export SLURM_CONF=$dir/slurm.conf" ;;
+        env)
+            [ -s "$dir/slurm.conf" ] || { echo "local-cluster.sh: no $dir/slurm.conf (local-cluster.sh start $dir)" >&2; return 1; }
+            echo "export SLURM_CONF=$dir/slurm.conf" ;;
+        stop) slurm_local_stop "$dir" ;;
+        -h|--help) sed -n '2,/^$/s/^# \{0,1\}//p' "${BASH_SOURCE[0]}" ;;
+        *) echo "local-cluster.sh: unknown command '$cmd' (start, env, stop, --help)" >&2; return 2 ;;
+    esac
+}
+
+if [ "${BASH_SOURCE[0]}" = "$0" ]; then
+    set -u
+    slurm_local_main "$@"
+fi

@@ -2,7 +2,8 @@
 # Cells by number: `tcbench cells` lists a config's cells in an order that
 # depends only on the config; `run --cell` and `run --shard I/N` (or
 # `--shard auto` under a Slurm array) run exactly those, and shards put
-# together equal a plain run bit for bit.
+# together equal a plain run bit for bit. `status` counts the cells of
+# tasks squeue lists as queued; scripts/slurm/submit.sh finds tcbench.
 set -euo pipefail
 : "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
 . "$(dirname "${BASH_SOURCE[0]}")/expect.sh"
@@ -45,6 +46,51 @@ SLURM_ARRAY_TASK_ID=6 SLURM_ARRAY_TASK_MIN=5 SLURM_ARRAY_TASK_MAX=7 \
 SLURM_ARRAY_TASK_ID=2 SLURM_ARRAY_TASK_COUNT=3 \
     expect 0 "cells: 2 in all" "$TCBENCH" run g.json --out sharded --shard auto --quiet
 same_cells plain sharded
+
+# `status` asks squeue for the tasks scripts/slurm/submit.sh queued (their
+# job comment names the run directory): their cells are queued, not
+# missing, nor in the --array list; a task of N shards stands for every id
+# that is its index modulo N. A fake squeue here, Slurm's in test_slurm.sh.
+"$TCBENCH" run g.json --out queue --cell 0,3 --quiet 2> /dev/null
+mkdir fake
+cat > fake/squeue <<SH
+#!/bin/sh
+cat <<'Q'
+57|1|PENDING|tcbench run=$tmp/queue
+57|2|RUNNING|tcbench run=$tmp/queue
+57|4|COMPLETED|tcbench run=$tmp/queue
+58|0|PENDING|tcbench shards=3 run=$tmp/queue
+59|5|PENDING|tcbench run=$tmp/queue-other
+60|N/A|PENDING|tcbench run=$tmp/queue
+61|7|PENDING|another job
+Q
+SH
+chmod +x fake/squeue
+PATH="$tmp/fake:$PATH" expect 0 "" "$TCBENCH" status g.json --out queue
+grep -qxF "queued   1-2,6: pending or running in Slurm (jobs 57 58)" out.txt &&
+    grep -qxF "queue: 8 cells: 2 done, 0 diverged, 0 failed, 0 running, 3 missing, 3 queued in Slurm" out.txt &&
+    grep -qxF "resubmit the cells a run computes (3 missing, 0 failed): --array=4-5,7" out.txt || { cat out.txt; exit 1; }
+# squeue failing: a warning, and the counts as without it; no squeue: nothing.
+printf '#!/bin/sh\necho "squeue: error: Unable to contact slurm controller" >&2\nexit 1\n' > fake/squeue
+PATH="$tmp/fake:$PATH" expect 0 "warning: squeue failed (squeue: error: Unable to contact slurm controller), so cells queued in Slurm count as missing" \
+    "$TCBENCH" status g.json --out queue
+grep -qxF "queue: 8 cells: 2 done, 0 diverged, 0 failed, 0 running, 6 missing" out.txt || { cat out.txt; exit 1; }
+PATH=/nonexistent "$TCBENCH" status g.json --out queue > out.txt 2> err.txt
+[ ! -s err.txt ] && grep -qxF "resubmit the cells a run computes (6 missing, 0 failed): --array=1-2,4-7" out.txt ||
+    { cat out.txt err.txt; exit 1; }
+
+# submit.sh finds tcbench ($TCBENCH, else the checkout's build/tcbench, else
+# PATH's) and says which; here every cell is done, so it submits nothing.
+mkdir -p tree/scripts/slurm tree/build bin
+cp "$TCB_SOURCE_DIR"/scripts/slurm/submit.sh "$TCB_SOURCE_DIR"/scripts/slurm/tcbench-array.sbatch tree/scripts/slurm/
+ln -s "$TCBENCH" bin/tcbench
+expect 0 "submit.sh: using $(realpath "$TCBENCH") (tcbench on PATH)" env -u TCBENCH PATH="$tmp/bin:/usr/bin:/bin" tree/scripts/slurm/submit.sh g.json
+grep -qF "submit.sh: nothing to submit: every cell of g.json is done, running or queued" err.txt || { cat err.txt; exit 1; }
+ln -s "$TCBENCH" tree/build/tcbench
+expect 0 "(this checkout's build)" env -u TCBENCH PATH="$tmp/bin:/usr/bin:/bin" tree/scripts/slurm/submit.sh g.json
+rm tree/build/tcbench
+expect 2 "submit.sh: no tcbench: neither $tmp/tree/build/tcbench (cmake --build build) nor tcbench on PATH; or set TCBENCH=/path/to/tcbench" \
+    env -u TCBENCH PATH=/usr/bin:/bin tree/scripts/slurm/submit.sh g.json
 
 expect 2 "--cell 8: cell 8 does not exist (the config has 8 cells, 0-7)" "$TCBENCH" run g.json --cell 8
 expect 2 "--cell 3-x: expected ids and ranges such as 3,5-7" "$TCBENCH" run g.json --cell 3-x

@@ -2,11 +2,16 @@
 # On a real Slurm: a one-node cluster on this machine (munged, slurmctld and
 # slurmd started here with a config written to a temporary directory, two
 # CPUs), scripts/slurm/submit.sh runs a small grid as a job array and the
-# cells equal a plain local run bit for bit; a training task told to stop
-# (USR1 to its batch shell, as --signal=B:USR1@120 does) saves its state,
-# exits 75, requeues itself and ends with the uninterrupted cell. Needs root
-# and Debian's slurm-wlm and munge (scripts/setup.sh --tests installs them);
-# skips loudly otherwise. The daemons are stopped whatever happens.
+# cells equal a plain local run bit for bit. Then three trainings are
+# stopped three ways: a plain `scancel --signal=TERM` (to the job step) and
+# USR1 to the batch shell (as --signal=B:USR1@120 does) each save the state,
+# exit 75 and requeue the task, which logs that it starts again after a
+# requeue; a plain `scancel` saves the state and is not requeued. While the
+# requeued tasks wait (BeginTime), `tcbench status` counts their cells as
+# queued, not missing, and submit.sh resubmits only the cancelled one; all
+# end with the uninterrupted cells. Needs root and Debian's slurm-wlm and
+# munge (scripts/setup.sh --tests installs them); skips loudly otherwise.
+# The daemons are stopped whatever happens.
 set -euo pipefail
 : "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
 source "$TCB_SOURCE_DIR/tests/integration/cells.sh"
@@ -16,7 +21,8 @@ if why=$(slurm_local_missing); then skip "$why"; fi
 
 tmp=$(mktemp -d)
 chmod 755 "$tmp"
-trap 'slurm_local_stop "$tmp"; rm -rf "$tmp"' EXIT
+refs=()
+trap '[ ${#refs[@]} -eq 0 ] || kill "${refs[@]}" 2> /dev/null; slurm_local_stop "$tmp"; rm -rf "$tmp"' EXIT
 cd "$tmp"
 why=$(slurm_local_start "$tmp" 2) || skip "$why"
 export SLURM_CONF="$tmp/slurm.conf"
@@ -33,42 +39,76 @@ JSON
 "$TCBENCH" run grid.json --out plain --quiet 2> /dev/null
 TCBENCH="$TCBENCH" "$TCB_SOURCE_DIR/scripts/slurm/submit.sh" grid.json --out "$tmp/slurm" \
     --sbatch "--wait -c 1 -o $tmp/task-%a.log" > submit.txt 2>&1 || { cat submit.txt task-*.log slurmctld.log; exit 1; }
+grep -qxF "submit.sh: using $(realpath "$TCBENCH") (TCBENCH)" submit.txt || { cat submit.txt; exit 1; }
 same_cells plain slurm
 
-# Preemption: USR1 to the batch shell mid-training; the task requeues itself.
-sed 's/"iterations": 100/"iterations": 800/; s/"seeds": \[0, 1\]/"seeds": [0]/' grid.json > long.json
-"$TCBENCH" run long.json --out plain-long --quiet 2> /dev/null
-TCBENCH="$TCBENCH" "$TCB_SOURCE_DIR/scripts/slurm/submit.sh" long.json --out "$tmp/long" \
+# Stops: three trainings (cells 1-3) after a nearest cell (0), one-CPU tasks.
+sed 's/"iterations": 100/"iterations": 800/; s/"seeds": \[0, 1\]/"seeds": [0, 1, 2]/
+     s/{ "name": "nearest" }/{ "name": "nearest", "seeds": [0] }/' grid.json > long.json
+# The uninterrupted cells, by two local runs sharing the cells, meanwhile.
+refs=()
+for _ in 1 2; do "$TCBENCH" run long.json --out plain-long --quiet 2> /dev/null & refs+=($!); done
+TCBENCH="$TCBENCH" "$TCB_SOURCE_DIR/scripts/slurm/submit.sh" long.json --out "$tmp/long" --max-running 3 \
     --sbatch "-c 1 -o $tmp/long-%a.log" > submit-long.txt 2>&1 || { cat submit-long.txt; exit 1; }
 job=$(sed -n 's/^Submitted batch job \([0-9]*\)$/\1/p' submit-long.txt)
-train=long/work/synth/quadruped_walk/mca/seed_0
-lock=long/cells/synth/quadruped_walk/mca/seed_0.json.lock
-for _ in $(seq 600); do [ -e "$lock" ] && break; sleep 0.1; done
-sleep 1 # into the training
-scancel --batch --signal=USR1 "${job}_1" || { echo "FAIL: could not signal the task"; cat long-1.log; exit 1; }
+scontrol show job "$job" | grep -q "ArrayTaskThrottle=3" || { echo "FAIL: --max-running"; scontrol show job "$job"; exit 1; }
+cell() { echo "long/cells/synth/quadruped_walk/mca/seed_$(($1 - 1)).json"; } # cell ID's file
+fail() { echo "FAIL: $1"; cat long-*.log; squeue; exit 1; }
+# training ID: wait until cell ID's task holds its lock and is into the training.
+training() {
+    for _ in $(seq 600); do [ -e "$(cell "$1").lock" ] && break; sleep 0.1; done
+    [ -e "$(cell "$1").lock" ] || fail "task $1 did not start"
+    sleep 1
+}
+training 1
+training 2
+scancel --signal=TERM "${job}_1" || fail "could not signal task 1"
+scancel "${job}_2" || fail "could not cancel task 2"
+training 3
+scancel --batch --signal=USR1 "${job}_3" || fail "could not signal task 3"
 # Slurm holds a requeued job back (BeginTime: until the old job's
 # credential has expired, 120 s); let it start sooner, but only 2 s after
 # the requeue: slurmd refuses a credential created within the second its
 # predecessor was revoked in (and the job then fails and leaves the queue).
-for _ in $(seq 600); do
-    scontrol show job "${job}_1" 2> /dev/null | grep -q "Reason=BeginTime" && break
-    sleep 0.1
+for k in 1 3; do
+    for _ in $(seq 600); do
+        scontrol show job "${job}_$k" 2> /dev/null | grep -q "Reason=BeginTime" && break
+        sleep 0.1
+    done
 done
+for _ in $(seq 100); do [ -z "$(squeue -h -j "${job}_2" 2> /dev/null)" ] && break; sleep 0.1; done
+# Cells 1 and 3 are queued (their tasks wait), cell 2 missing (cancelled).
+"$TCBENCH" status long.json --out long > status.txt
+grep -qxF "queued   1,3: pending or running in Slurm (job $job)" status.txt &&
+    grep -qF "long: 4 cells: 1 done, 0 diverged, 0 failed, 0 running, 1 missing, 2 queued in Slurm" status.txt &&
+    grep -qxF "resubmit the cells a run computes (1 missing, 0 failed): --array=2" status.txt ||
+    { echo "FAIL: status"; cat status.txt; squeue -r; exit 1; }
+TCBENCH="$TCBENCH" "$TCB_SOURCE_DIR/scripts/slurm/submit.sh" long.json --out "$tmp/long" \
+    --sbatch "-c 1 -o $tmp/again-%a.log" > submit-again.txt 2>&1 || { cat submit-again.txt; exit 1; }
+again=$(sed -n 's/^Submitted batch job \([0-9]*\)$/\1/p' submit-again.txt)
+scontrol show job "$again" | grep -qw "ArrayTaskId=2" || { echo "FAIL: not cell 2 alone"; scontrol show job "$again"; exit 1; }
 sleep 2
 scontrol update JobId="${job}_1" StartTime=now
-for _ in $(seq 1200); do
-    [ -s long/cells/synth/quadruped_walk/mca/seed_0.json ] && [ -z "$(squeue -h -j "$job" 2> /dev/null)" ] && break
+scontrol update JobId="${job}_3" StartTime=now
+for _ in $(seq 1500); do
+    [ -s "$(cell 1)" ] && [ -s "$(cell 2)" ] && [ -s "$(cell 3)" ] && [ -z "$(squeue -h 2> /dev/null)" ] && break
     sleep 0.2
 done
-[ -s long/cells/synth/quadruped_walk/mca/seed_0.json ] || {
-    echo "FAIL: the requeued task did not finish"
-    cat long-*.log; squeue; scontrol show job "${job}_1"; tail -20 slurmctld.log slurmd.log
-    exit 1
-}
-# Where the stop lands depends on the machine's speed: mid-training mostly.
-grep -qE "stopped (at iteration [0-9]+ of 800; training state saved|at pair|before cell)" long-1.log &&
-    grep -qF "stopped with its state saved; requeueing ${job}_1" long-1.log || { echo "FAIL: no requeue"; cat long-1.log; exit 1; }
-[ "$(grep -c "computed" long-0.log)" -eq 1 ] || { echo "FAIL: the other task ran again"; cat long-0.log; exit 1; }
-[ ! -e "$train/train.ckpt" ] || { echo "FAIL: training state left"; exit 1; }
+[ -s "$(cell 1)" ] && [ -s "$(cell 2)" ] && [ -s "$(cell 3)" ] ||
+    { cat again-*.log; scontrol show job "${job}_1"; tail -20 slurmctld.log slurmd.log; fail "the tasks did not finish"; }
+# Where a stop lands depends on the machine's speed: mid-training mostly.
+saved="stopped (at iteration [0-9]+ of 800; training state saved|at pair|before cell)"
+requeued="starts again after a requeue (restart 1); a \"CANCELLED ... DUE TO JOB REQUEUE\" line above"
+for k in 1 3; do
+    grep -qE "$saved" "long-$k.log" && grep -qF "stopped with its state saved; requeueing ${job}_$k (" "long-$k.log" &&
+        grep -qF "tcbench: task ${job}_$k $requeued" "long-$k.log" || fail "task $k was not requeued"
+done
+grep -qF "SIGTERM received" long-1.log && grep -qF "SIGUSR1 received" long-3.log || fail "not the signals sent"
+grep -qE "$saved" long-2.log && grep -qF "Slurm is ending ${job}_2 (" long-2.log &&
+    ! grep -qF "requeueing" long-2.log || fail "the cancelled task was requeued"
+[ "$(grep -c "computed" long-0.log)" -eq 1 ] || fail "the other task ran again"
+[ -z "$(find long/work -name train.ckpt)" ] || fail "training state left"
+for r in "${refs[@]}"; do wait "$r" || { echo "FAIL: the local run"; exit 1; }; done
+refs=()
 same_cells plain-long long
 echo "slurm test passed"
