@@ -110,9 +110,11 @@ int tcb_cell_lock_holder(const char *cell_path, tcb_lock_info *info);
 
 /* The cells of a run directory that Slurm has queued (pending or running
  * array tasks submitted by scripts/slurm/submit.sh), from squeue
- * (harness/slurm_queue.c). Without squeue, or with no such directory, an
- * empty queue; when squeue fails, an empty queue and a one-line note. -1
- * only when out of memory. Free with tcb_slurm_queue_free. */
+ * (harness/slurm_queue.c), asked only when submit.sh has left its mark
+ * TCB_SLURM_MARK in the directory. Without squeue, the mark or the
+ * directory, an empty queue; when squeue fails, an empty queue and a
+ * one-line note. -1 only when out of memory. Free with tcb_slurm_queue_free. */
+#define TCB_SLURM_MARK "slurm-submissions.log"
 typedef struct tcb_slurm_queue {
     unsigned char *queued; /* [n_cells] 1: a queued task will run the cell */
     int n_cells;

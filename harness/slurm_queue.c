@@ -4,12 +4,16 @@
  * "tcbench run=DIR", or "tcbench shards=N run=DIR" with --tasks N) marks
  * the cells it will run as the scripts map them: its index is the cell id,
  * or with N shards every id that is its index modulo N. Only pending and
- * running tasks count (squeue also lists finished ones for a while). */
+ * running tasks count (squeue also lists finished ones for a while).
+ * Only a run directory that submit.sh has submitted (it leaves
+ * TCB_SLURM_MARK there) is asked about: a local run's status stays quiet
+ * and quick wherever squeue is installed. */
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include "harness/internal.h"
 
@@ -76,7 +80,10 @@ int tcb_slurm_queue_read(const char *run_dir, int n_cells, tcb_slurm_queue *q, c
     memset(q, 0, sizeof *q);
     note[0] = '\0';
     char abs_dir[PATH_MAX];
+    char mark[PATH_MAX + 32];
     if (!realpath(run_dir, abs_dir)) return 0; /* no directory: nothing was submitted for it */
+    snprintf(mark, sizeof mark, "%s/%s", abs_dir, TCB_SLURM_MARK);
+    if (access(mark, F_OK)) return 0; /* never submitted to Slurm: nothing to ask */
     if (!(q->queued = calloc(n_cells > 0 ? n_cells : 1, 1))) return -1;
     q->n_cells = n_cells;
     FILE *p = popen(SQUEUE_CMD, "r");

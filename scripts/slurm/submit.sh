@@ -60,6 +60,9 @@ fi
 run_dir=$(sed -n 's/^\(.*\): [0-9]* cells: .*/\1/p' <<< "$status")
 mkdir -p "$run_dir"
 run_dir=$(realpath "$run_dir")
+# The mark that makes `tcbench status` ask squeue about this run directory
+# (a run that never went through Slurm is not asked about).
+printf '%s %s\n' "$(date -u +%Y-%m-%dT%H:%M:%SZ)" "$config" >> "$run_dir/slurm-submissions.log"
 export TCBENCH="$tcbench"
 if [ "$tasks" -gt 0 ]; then
     # shellcheck disable=SC2086 # sbatch_args is a list of words

@@ -66,6 +66,10 @@ cat <<'Q'
 Q
 SH
 chmod +x fake/squeue
+# A run directory submit.sh never submitted is not asked about.
+PATH="$tmp/fake:$PATH" expect 0 "" "$TCBENCH" status g.json --out queue
+grep -q "queued" out.txt && { echo "FAIL: status asked squeue about a run never submitted"; cat out.txt; exit 1; }
+echo "2026-12-03T00:00:00Z g.json" > queue/slurm-submissions.log
 PATH="$tmp/fake:$PATH" expect 0 "" "$TCBENCH" status g.json --out queue
 grep -qxF "queued   1-2,6: pending or running in Slurm (jobs 57 58)" out.txt &&
     grep -qxF "queue: 8 cells: 2 done, 0 diverged, 0 failed, 0 running, 3 missing, 3 queued in Slurm" out.txt &&
