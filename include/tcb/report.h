@@ -21,6 +21,14 @@ extern "C" {
  * (m_sL2 by frame distance |i − j|), out_dir NULL → <run>/report, and
  * echoes the Markdown tables to `echo` if non-NULL. */
 int tcb_report_write(const char *run_dir, const char *out_dir, FILE *echo, tcb_error *err);
+/* The same with `resamples` bootstrap resamples per comparison (0: the
+ * default, TCB_BOOT_RESAMPLES = 10 000). Every report also writes
+ * comparisons.{md,tex,csv} (tcb/compare.h: per sequence and metric, each
+ * pair of methods' difference, 95 % interval and Holm-adjusted p), and
+ * bolds a best value only when it is significantly better than every other
+ * method, marking tied leaders otherwise (docs/protocol.md). */
+int tcb_report_write_resampled(const char *run_dir, const char *out_dir, int resamples, FILE *echo,
+                               tcb_error *err);
 
 /* Our tables beside a reference's (the paper's numbers: `reference` is a
  * built-in name, "iccv21", or a tcbench-reference/1 file): the tables the
