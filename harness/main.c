@@ -267,7 +267,9 @@ static int cmd_report(const cli *c)
     const char *out = c->value[F_OUT];
     if (c->value[F_REFERENCE]) {
         FILE *echo = c->set[F_QUIET] ? NULL : stdout;
-        if (tcb_report_reference(c->arg[0], c->value[F_REFERENCE], out, echo, &err)) return fail(&err);
+        if (tcb_report_reference_resampled(c->arg[0], c->value[F_REFERENCE], out, (int)flag_int(c, F_RESAMPLES, 0),
+                                           echo, &err))
+            return fail(&err);
         fprintf(stderr, "report: %s/reference_*.{md,tex,csv}\n", out ? out : c->arg[0]);
         return 0;
     }

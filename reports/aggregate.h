@@ -152,6 +152,9 @@ int tcb_rpt_compare_mean(tcb_rpt_block *m, const tcb_rpt_block *const *tests, in
 /* The comparison of rows ra and rb of b (either order; *flip set when it is
  * rb − ra), NULL when not compared. */
 const tcb_rpt_cmp *tcb_rpt_cmp_of(const tcb_rpt_block *b, int ra, int rb, int *flip);
+/* Row r of b significantly better than its row o by metric m
+ * (tcb_cmp_significant, the difference in r's favour). */
+int tcb_rpt_beats(const tcb_rpt_block *b, int r, int o, int m);
 void tcb_rpt_free(tcb_rpt *r);
 
 /* One table cell: "mean<pm>std" in the metric's precision, "-" when the row

@@ -70,8 +70,7 @@ static int holm_metric(tcb_rpt_block *b, int m, tcb_error *err)
     return rc;
 }
 
-/* Row `r` significantly better than row `o` by metric m. */
-static int beats(const tcb_rpt_block *b, int r, int o, int m)
+int tcb_rpt_beats(const tcb_rpt_block *b, int r, int o, int m)
 {
     int flip;
     const tcb_rpt_cmp *x = tcb_rpt_cmp_of(b, r, o, &flip);
@@ -97,13 +96,13 @@ static void mark_metric(tcb_rpt_block *b, int m)
     if (n < 2) return;
     int all = 1;
     for (int k = 0; k < b->n_rows; k++)
-        if (k != lead && candidate(&b->rows[k], m)) all &= beats(b, lead, k, m);
+        if (k != lead && candidate(&b->rows[k], m)) all &= tcb_rpt_beats(b, lead, k, m);
     if (all) {
         b->rows[lead].best[m] = 1;
         return;
     }
     for (int k = 0; k < b->n_rows; k++)
-        b->rows[k].tie[m] = candidate(&b->rows[k], m) && (k == lead || !beats(b, lead, k, m));
+        b->rows[k].tie[m] = candidate(&b->rows[k], m) && (k == lead || !tcb_rpt_beats(b, lead, k, m));
 }
 
 static int adjust_and_mark(tcb_rpt_block *b, tcb_error *err)

@@ -39,6 +39,11 @@ int tcb_report_write_resampled(const char *run_dir, const char *out_dir, int res
  * echoes the Markdown to `echo` if non-NULL. */
 int tcb_report_reference(const char *run_dir, const char *reference, const char *out_dir, FILE *echo,
                          tcb_error *err);
+/* The same with `resamples` per comparison (0: the default); each ordering
+ * the paper makes is said to agree, flip significantly or flip within the
+ * noise (the comparisons of tcb_report_write_resampled). */
+int tcb_report_reference_resampled(const char *run_dir, const char *reference, const char *out_dir, int resamples,
+                                   FILE *echo, tcb_error *err);
 
 /* Baseline file "tcbench-baseline/1": per (dataset, sequence, method) the four
  * metrics in table units, plus per-metric tolerances. */
