@@ -150,6 +150,29 @@ static void print_result(FILE *f, const target *t, const tcb_cmp *c)
     }
 }
 
+/* A's and B's MEAN rows of d as a two-row block (A then B), compared over
+ * the test blocks tests[0..nt) as a report compares them. */
+static int compare_mean_rows(const tcb_rpt_dataset *d, const target *t, const tcb_rpt_block *const *tests, int nt,
+                             int resamples, tcb_cmp *out, tcb_error *err)
+{
+    const tcb_rpt_row *ra = NULL, *rb = NULL;
+    for (int k = 0; k < d->mean.n_rows; k++) {
+        if (!strcmp(d->mean.rows[k].method, t->a)) ra = &d->mean.rows[k];
+        if (!strcmp(d->mean.rows[k].method, t->b)) rb = &d->mean.rows[k];
+    }
+    if (!ra || !rb)
+        return tcb_fail(err, TCB_ERR_INPUT, "compare: %s has no cell on a test sequence of %s: no MEAN",
+                        ra ? t->b : t->a, t->dataset);
+    tcb_rpt_row two[2] = {*ra, *rb};
+    tcb_rpt_block mb = {.n_rows = 2, .rows = two};
+    int rc = tcb_rpt_compare_mean(&mb, tests, nt, resamples, err);
+    if (!rc && mb.cmp[0].note[0])
+        rc = tcb_fail(err, TCB_ERR_INPUT, "compare: MEAN of %s: %s", t->dataset, mb.cmp[0].note);
+    if (!rc) *out = mb.cmp[0].c;
+    free(mb.cmp);
+    return rc;
+}
+
 /* Over the dataset's test sequences, from the table's per-sequence means. */
 static int compare_mean(const tcb_cell_result *c, int n, const target *t, int resamples, tcb_cmp *out,
                         tcb_error *err)
@@ -157,37 +180,16 @@ static int compare_mean(const tcb_cell_result *c, int n, const target *t, int re
     tcb_rpt r;
     int rc = tcb_rpt_build(c, n, TCB_RPT_NO_STATS, &r, err);
     if (rc) return rc;
-    const tcb_rpt_dataset *d = NULL;
+    const tcb_rpt_dataset *d = &r.datasets[0]; /* resolve() made sure the dataset has cells */
     for (int k = 0; k < r.n_datasets; k++)
         if (!strcmp(r.datasets[k].name, t->dataset)) d = &r.datasets[k];
-    const tcb_rpt_block **tests = d ? malloc(sizeof *tests * (size_t)d->n) : NULL;
+    const tcb_rpt_block **tests = malloc(sizeof *tests * (size_t)d->n);
     int nt = 0;
     if (!tests) rc = tcb_fail(err, TCB_ERR_NOMEM, "compare: out of memory");
     for (int k = 0; !rc && k < d->n; k++)
         if (!strcmp(r.blocks[d->first + k].role, "test")) tests[nt++] = &r.blocks[d->first + k];
     if (!rc && nt == 0) rc = tcb_fail(err, TCB_ERR_INPUT, "compare: %s has no test sequence: no MEAN", t->dataset);
-    tcb_rpt_block mb = {.rows = NULL};
-    if (!rc) {
-        /* A two-row MEAN block: A then B, compared as a report compares them. */
-        const tcb_rpt_row *ra = NULL, *rb = NULL;
-        for (int k = 0; k < d->mean.n_rows; k++) {
-            if (!strcmp(d->mean.rows[k].method, t->a)) ra = &d->mean.rows[k];
-            if (!strcmp(d->mean.rows[k].method, t->b)) rb = &d->mean.rows[k];
-        }
-        if (!ra || !rb) {
-            rc = tcb_fail(err, TCB_ERR_INPUT, "compare: %s has no cell on a test sequence of %s: no MEAN",
-                          ra ? t->b : t->a, t->dataset);
-            goto done;
-        }
-        tcb_rpt_row two[2] = {*ra, *rb};
-        mb.n_rows = 2, mb.rows = two;
-        rc = tcb_rpt_compare_mean(&mb, tests, nt, resamples, err);
-        if (!rc && mb.cmp[0].note[0]) rc = tcb_fail(err, TCB_ERR_INPUT, "compare: MEAN of %s: %s", t->dataset,
-                                                   mb.cmp[0].note);
-        if (!rc) *out = mb.cmp[0].c;
-        free(mb.cmp);
-    }
-done:
+    if (!rc) rc = compare_mean_rows(d, t, tests, nt, resamples, out, err);
     free(tests);
     tcb_rpt_free(&r);
     return rc;
