@@ -2,7 +2,8 @@
  *
  * Tables are shaped like the paper's: one block per sequence, rows =
  * methods, columns m_sL2 ×1e3 ↓, rank % ↓, AUC % ↑, CD ×1e3 ↓ as mean ± std,
- * best in bold, "-" where a method has no reconstruction; a MEAN block per
+ * the best in bold when significantly best, else the leaders marked tied
+ * (tcb/compare.h), "-" where a method has no reconstruction; a MEAN block per
  * dataset averages per-sequence means and stds over TEST sequences only
  * (reference-protocol §5.6). Cells of several seeds pool their pairs. */
 #ifndef TCB_REPORT_H
