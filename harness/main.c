@@ -20,7 +20,7 @@ enum {
     F_OUT, F_ONLY, F_FORCE, F_QUIET, F_REPORT, F_SEED, F_FRAMES, F_SEQUENCE, F_UPDATE,
     F_PLUGIN, F_THREADS, F_VERBOSE, F_SAMPLES, F_PLOT, F_ROOT, F_VARIANT, F_DRY_RUN, F_REFERENCE, F_CELL,
     F_SHARD, F_LOCK_TIMEOUT, F_DATASET, F_PRED, F_NAME, F_HELP,
-    F_N_FRAMES, F_STYLE, F_ANY_FRAME, F_COUNT
+    F_N_FRAMES, F_STYLE, F_ANY_FRAME, F_RESAMPLES, F_COUNT
 };
 #define BIT(f) (1u << (f))
 
@@ -37,7 +37,7 @@ static const struct {
     [F_CELL] = {"--cell", 1},    [F_SHARD] = {"--shard", 1},   [F_LOCK_TIMEOUT] = {"--lock-timeout", 1},
     [F_DATASET] = {"--dataset", 1}, [F_PRED] = {"--pred", 1},  [F_NAME] = {"--name", 1},
     [F_HELP] = {"--help", 0},    [F_N_FRAMES] = {"--count", 1}, [F_STYLE] = {"--style", 1},
-    [F_ANY_FRAME] = {"--any-frame", 0},
+    [F_ANY_FRAME] = {"--any-frame", 0}, [F_RESAMPLES] = {"--resamples", 1},
 };
 
 #define MAX_PLUGINS 64
@@ -101,6 +101,7 @@ static const struct int_flag {
     {F_N_FRAMES, NULL, 1, TCB_FRAMES_MAX},
     {F_SAMPLES, NULL, 1, 10000000},
     {F_LOCK_TIMEOUT, NULL, 1, 1000000000},
+    {F_RESAMPLES, NULL, 100, 10000000},   /* bootstrap resamples per comparison */
 };
 
 static const struct int_flag *int_flag_of(const char *cmd, int f)
@@ -268,13 +269,26 @@ static int cmd_report(const cli *c)
     const char *out = c->value[F_OUT];
     if (c->value[F_REFERENCE]) {
         FILE *echo = c->set[F_QUIET] ? NULL : stdout;
-        if (tcb_report_reference(c->arg[0], c->value[F_REFERENCE], out, echo, &err)) return fail(&err);
+        if (tcb_report_reference_resampled(c->arg[0], c->value[F_REFERENCE], out, (int)flag_int(c, F_RESAMPLES, 0),
+                                           echo, &err))
+            return fail(&err);
         fprintf(stderr, "report: %s/reference_*.{md,tex,csv}\n", out ? out : c->arg[0]);
         return 0;
     }
-    if (tcb_report_write(c->arg[0], out, c->set[F_QUIET] ? NULL : stdout, &err)) return fail(&err);
+    if (tcb_report_write_resampled(c->arg[0], out, (int)flag_int(c, F_RESAMPLES, 0), c->set[F_QUIET] ? NULL : stdout,
+                                   &err))
+        return fail(&err);
     if (out) fprintf(stderr, "report: %s/\n", out);
     else fprintf(stderr, "report: %s/report/\n", c->arg[0]);
+    return 0;
+}
+
+static int cmd_compare(const cli *c)
+{
+    tcb_error err = {0};
+    if (tcb_compare_run(c->arg[0], c->value[F_DATASET], c->value[F_SEQUENCE], c->arg[1], c->arg[2],
+                        (int)flag_int(c, F_RESAMPLES, 0), stdout, &err))
+        return fail(&err);
     return 0;
 }
 
@@ -576,10 +590,12 @@ static const command commands[] = {
      "examples:\n"
      "  tcbench status runs/paper/table6-delta/cpu\n"
      "  sbatch --array=$(tcbench status runs/x | sed -n 's/.*--array=//p') ...\n"},
-    {"report", cmd_report, BIT(F_OUT) | BIT(F_QUIET) | BIT(F_REFERENCE), 1, 1, "RUN_DIR",
-     "usage: tcbench report RUN_DIR [--reference NAME] [--out DIR] [--quiet]\n"
+    {"report", cmd_report, BIT(F_OUT) | BIT(F_QUIET) | BIT(F_REFERENCE) | BIT(F_RESAMPLES), 1, 1, "RUN_DIR",
+     "usage: tcbench report RUN_DIR [--reference NAME] [--out DIR] [--resamples N] [--quiet]\n"
      "\n"
-     "Writes tables.md, tables.tex, results.csv, by_gap.csv, and per sequence the PCK\n"
+     "Writes tables.md, tables.tex, results.csv, by_gap.csv, seeds.csv,\n"
+     "comparisons.md, .tex and .csv (each pair of methods per sequence and metric:\n"
+     "difference, 95 % bootstrap interval, Holm-adjusted Wilcoxon p), and per sequence the PCK\n"
      "curves, the geodesic PCK curves and m_sL2 by frame distance (log scale) as PNG\n"
      "plots, for a run directory, and prints the Markdown tables (the paper's\n"
      "metrics, then the geodesic error m_geo and AUC_geo: docs/protocol.md) on\n"
@@ -595,11 +611,36 @@ static const command commands[] = {
      "  --reference NAME  iccv21 (built in: every table of the ICCV'21 paper and its\n"
      "                    supplement) or a tcbench-reference/1 file\n"
      "  --out DIR         where to write (default: RUN_DIR/report)\n"
+     "  --resamples N     bootstrap resamples per comparison (default 10000)\n"
      "  --quiet           do not print the tables\n"
+     "\n"
+     "A best value is bold only when significantly better than every other method\n"
+     "(Holm-adjusted p < 0.05 and the interval excluding 0); otherwise the leaders\n"
+     "tied for best are marked (docs/protocol.md, \"Statistics of a comparison\").\n"
      "\n"
      "examples:\n"
      "  tcbench report runs/quick\n"
      "  tcbench report runs/paper/table5-nricp/cpu --reference iccv21\n"},
+    {"compare", cmd_compare, BIT(F_SEQUENCE) | BIT(F_DATASET) | BIT(F_RESAMPLES), 3, 3, "RUN_DIR A B",
+     "usage: tcbench compare RUN_DIR A B [--sequence S|DATASET/S|MEAN] [--dataset D] [--resamples N]\n"
+     "\n"
+     "Compares method A with method B (the config's labels) on one sequence: per\n"
+     "metric, the means of A and B, A - B with its 95 % interval (seeded\n"
+     "hierarchical paired bootstrap: A's seeds, B's seeds, then the split's pairs,\n"
+     "the same for both) and the two-sided Wilcoxon signed-rank p of the\n"
+     "seed-averaged per-pair differences (raw: one comparison, nothing to adjust\n"
+     "for), and whether the difference is significant. With one seed on a side the\n"
+     "interval leaves out the training variance; it says so. MEAN: across the\n"
+     "dataset's test sequences (the sequences resampled; rough when few).\n"
+     "\n"
+     "options:\n"
+     "  --sequence S   the sequence (default: the only one with cells of both)\n"
+     "  --dataset D    its dataset (default: the only one with cells of both)\n"
+     "  --resamples N  bootstrap resamples (default 10000)\n"
+     "\n"
+     "examples:\n"
+     "  tcbench compare runs/quick nricp nearest --sequence quadruped_walk\n"
+     "  tcbench compare runs/paper/table5-nricp/cpu nricp nearest --sequence MEAN --dataset anim\n"},
     {"methods", cmd_methods, 0, 0, 0, "",
      "usage: tcbench methods [--plugin SO]...\n"
      "\n"

@@ -258,7 +258,7 @@ static int block_seeds(const tcb_cell_result *cells, int n, tcb_rpt_block *b, tc
 }
 
 /* cells[0 .. n): one (dataset, sequence), sorted by method then seed. */
-static int build_block(const tcb_cell_result *cells, int n, tcb_rpt_block *b, tcb_error *err)
+static int build_block(const tcb_cell_result *cells, int n, int resamples, tcb_rpt_block *b, tcb_error *err)
 {
     memset(b, 0, sizeof *b);
     snprintf(b->dataset, sizeof b->dataset, "%s", cells[0].dataset);
@@ -280,7 +280,9 @@ static int build_block(const tcb_cell_result *cells, int n, tcb_rpt_block *b, tc
         k = e;
     }
     int rc = block_seeds(cells, n, b, err);
-    return rc ? rc : finish_block(b, err);
+    if (!rc) rc = finish_block(b, err);
+    if (!rc && resamples != TCB_RPT_NO_STATS) rc = tcb_rpt_compare_block(b, cells, n, resamples, err);
+    return rc;
 }
 
 /* ------------------------------------------------------ MEAN of a dataset */
@@ -342,7 +344,7 @@ static int cmp_row(const void *a, const void *b)
     return strcmp(((const tcb_rpt_row *)a)->method, ((const tcb_rpt_row *)b)->method);
 }
 
-static int build_mean(tcb_rpt *r, tcb_rpt_dataset *d, tcb_error *err)
+static int build_mean(tcb_rpt *r, tcb_rpt_dataset *d, int resamples, tcb_error *err)
 {
     const tcb_rpt_block **tests = malloc((size_t)d->n * sizeof *tests);
     if (!tests) return tcb_fail(err, TCB_ERR_NOMEM, "report: out of memory");
@@ -380,13 +382,15 @@ static int build_mean(tcb_rpt *r, tcb_rpt_dataset *d, tcb_error *err)
         }
     qsort(m->rows, (size_t)m->n_rows, sizeof *m->rows, cmp_row);
     snprintf(m->seeds, sizeof m->seeds, "%s", tests[0]->seeds);
+    int rc = finish_block(m, err);
+    if (!rc && resamples != TCB_RPT_NO_STATS) rc = tcb_rpt_compare_mean(m, tests, nt, resamples, err);
     free(tests);
-    return finish_block(m, err);
+    return rc;
 }
 
 /* --------------------------------------------------------------- the run */
 
-static int build_datasets(tcb_rpt *r, tcb_error *err)
+static int build_datasets(tcb_rpt *r, int resamples, tcb_error *err)
 {
     r->datasets = calloc((size_t)r->n_blocks, sizeof *r->datasets);
     if (!r->datasets) return tcb_fail(err, TCB_ERR_NOMEM, "report: out of memory");
@@ -396,13 +400,13 @@ static int build_datasets(tcb_rpt *r, tcb_error *err)
         d->first = k;
         while (k < r->n_blocks && !strcmp(r->blocks[k].dataset, d->name)) k++;
         d->n = k - d->first;
-        int rc = build_mean(r, d, err);
+        int rc = build_mean(r, d, resamples, err);
         if (rc) return rc;
     }
     return TCB_OK;
 }
 
-int tcb_rpt_build(const tcb_cell_result *cells, int n, tcb_rpt *out, tcb_error *err)
+int tcb_rpt_build(const tcb_cell_result *cells, int n, int resamples, tcb_rpt *out, tcb_error *err)
 {
     memset(out, 0, sizeof *out);
     if (n <= 0) return TCB_OK;
@@ -412,15 +416,20 @@ int tcb_rpt_build(const tcb_cell_result *cells, int n, tcb_rpt *out, tcb_error *
     for (int k = 0; k < n && !rc;) {
         int e = k + 1;
         while (e < n && same_block(&cells[k], &cells[e])) e++;
-        rc = build_block(cells + k, e - k, &out->blocks[out->n_blocks++], err);
+        rc = build_block(cells + k, e - k, resamples, &out->blocks[out->n_blocks++], err);
         k = e;
     }
-    if (!rc) rc = build_datasets(out, err);
+    if (!rc) rc = build_datasets(out, resamples, err);
     if (rc) tcb_rpt_free(out);
     return rc;
 }
 
 int tcb_rpt_load(const char *run_dir, tcb_rpt *out, tcb_error *err)
+{
+    return tcb_rpt_load_compared(run_dir, TCB_RPT_NO_STATS, out, err);
+}
+
+int tcb_rpt_load_compared(const char *run_dir, int resamples, tcb_rpt *out, tcb_error *err)
 {
     memset(out, 0, sizeof *out);
     tcb_cell_result *cells;
@@ -430,7 +439,7 @@ int tcb_rpt_load(const char *run_dir, tcb_rpt *out, tcb_error *err)
     if (n == 0)
         rc = tcb_fail(err, TCB_ERR_INPUT, "%s/cells: no cell files: nothing to report", run_dir);
     else
-        rc = tcb_rpt_build(cells, n, out, err);
+        rc = tcb_rpt_build(cells, n, resamples, out, err);
     for (int k = 0; k < n; k++) tcb_cell_free(&cells[k]);
     free(cells);
     return rc;
@@ -445,8 +454,12 @@ void tcb_rpt_free(tcb_rpt *r)
         }
         free(r->blocks[k].rows);
         free(r->blocks[k].seed_list);
+        free(r->blocks[k].cmp);
     }
-    for (int k = 0; k < r->n_datasets; k++) free(r->datasets[k].mean.rows);
+    for (int k = 0; k < r->n_datasets; k++) {
+        free(r->datasets[k].mean.rows);
+        free(r->datasets[k].mean.cmp);
+    }
     free(r->blocks);
     free(r->datasets);
     memset(r, 0, sizeof *r);

@@ -13,6 +13,7 @@
 
 #include <stddef.h>
 
+#include "tcb/compare.h"
 #include "tcb/error.h"
 #include "tcb/metrics.h"
 #include "tcb/results.h"
@@ -68,7 +69,11 @@ typedef struct tcb_rpt_row {
     int n_seeds;                      /* cells pooled (MEAN rows: the most of any sequence) */
     int n_pairs;                      /* pairs per cell (MEAN rows: sum over sequences) */
     int has[TCB_N_METRICS];           /* 0 → "-" (no reconstruction, or not ok) */
-    int best[TCB_N_METRICS];          /* best of its block as displayed */
+    int best[TCB_N_METRICS];          /* best of its block: as displayed without statistics;
+                                       * with them, significantly better than every other
+                                       * row (reports/significance.c) */
+    int tie[TCB_N_METRICS];           /* with statistics: a leader not significantly apart
+                                       * from the best (no row is then best) */
     double mean[TCB_N_METRICS];       /* table units */
     double std[TCB_N_METRICS];        /* table units */
     double sl2sq_mean, sl2sq_std;     /* ×1e3; valid when has[TCB_M_SL2] */
@@ -82,6 +87,15 @@ typedef struct tcb_rpt_row {
     tcb_rpt_seed *by_seed;            /* malloc'ed [n_by_seed], ascending seed */
 } tcb_rpt_row;
 
+/* Two rows of a block compared (tcb/compare.h), a < b as row indices: a
+ * minus b. Per sequence over pairs and seeds, in MEAN blocks over the test
+ * sequences. p_holm is adjusted over the block's comparisons of one metric. */
+typedef struct tcb_rpt_cmp {
+    int a, b;
+    char note[TCB_ERRMSG_MAX];        /* why not compared ("" when compared) */
+    tcb_cmp c;                        /* c.m[m].has: metric m compared */
+} tcb_rpt_cmp;
+
 typedef struct tcb_rpt_block {
     char dataset[64];
     char sequence[128];               /* "MEAN" for a dataset mean block */
@@ -92,6 +106,9 @@ typedef struct tcb_rpt_block {
     int n_pairs_min, n_pairs_max;     /* over the block's rows */
     int n_rows;
     tcb_rpt_row *rows;                /* [n_rows], sorted by method */
+    int compared;                     /* statistics made: cmp, best and tie as below */
+    int n_cmp;
+    tcb_rpt_cmp *cmp;                 /* malloc'ed [n_cmp]: every pair of rows, (0,1), (0,2)… */
 } tcb_rpt_block;
 
 typedef struct tcb_rpt_dataset {
@@ -109,10 +126,35 @@ typedef struct tcb_rpt {
     tcb_rpt_dataset *datasets;
 } tcb_rpt;
 
-/* cells sorted as tcb_results_scan returns them. */
-int tcb_rpt_build(const tcb_cell_result *cells, int n, tcb_rpt *out, tcb_error *err);
-/* Scan <run>/cells and build; a run without cells is an error. */
+/* No statistics: best[] marks the displayed best (baselines, check). */
+#define TCB_RPT_NO_STATS (-1)
+
+/* cells sorted as tcb_results_scan returns them. resamples: the
+ * comparisons' bootstrap resamples (0: TCB_BOOT_RESAMPLES), or
+ * TCB_RPT_NO_STATS. */
+int tcb_rpt_build(const tcb_cell_result *cells, int n, int resamples, tcb_rpt *out, tcb_error *err);
+/* Scan <run>/cells and build without statistics; a run without cells is an error. */
 int tcb_rpt_load(const char *run_dir, tcb_rpt *out, tcb_error *err);
+/* The same with the comparisons (resamples as tcb_rpt_build). */
+int tcb_rpt_load_compared(const char *run_dir, int resamples, tcb_rpt *out, tcb_error *err);
+
+/* ---- statistics (reports/significance.c) ---- */
+
+/* The block's rows compared pair by pair from its cells (those of
+ * tcb_rpt_build's block), Holm per metric, then best and tie set by the
+ * rule of docs/protocol.md. A pair whose cells cannot be paired (other
+ * splits) is left uncompared with a note, not an error. */
+int tcb_rpt_compare_block(tcb_rpt_block *b, const tcb_cell_result *cells, int n, int resamples,
+                          tcb_error *err);
+/* A MEAN block from the test blocks tests[0..nt): over sequences. */
+int tcb_rpt_compare_mean(tcb_rpt_block *m, const tcb_rpt_block *const *tests, int nt, int resamples,
+                         tcb_error *err);
+/* The comparison of rows ra and rb of b (either order; *flip set when it is
+ * rb − ra), NULL when not compared. */
+const tcb_rpt_cmp *tcb_rpt_cmp_of(const tcb_rpt_block *b, int ra, int rb, int *flip);
+/* Row r of b significantly better than its row o by metric m
+ * (tcb_cmp_significant, the difference in r's favour). */
+int tcb_rpt_beats(const tcb_rpt_block *b, int r, int o, int m);
 void tcb_rpt_free(tcb_rpt *r);
 
 /* One table cell: "mean<pm>std" in the metric's precision, "-" when the row

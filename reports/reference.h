@@ -53,6 +53,8 @@ extern const char *const tcb_reference_builtin_texts[];
 typedef struct tcb_ref_cmp_row {
     const tcb_ref_row *paper;
     const tcb_rpt_row *ours;
+    const tcb_rpt_block *block;      /* ours's block, and ours's index in it */
+    int index;
 } tcb_ref_cmp_row;
 
 /* Rows of one (dataset, sequence) of a table: the methods the paper
@@ -83,11 +85,19 @@ int tcb_ref_compare(const tcb_reference *ref, const tcb_rpt *r, const char (*ids
                     tcb_error *err);
 void tcb_ref_cmp_free(tcb_ref_cmp *c);
 
-/* How the methods of a group are ordered by metric m, here and in the
- * paper: *n_pairs compared pairs of rows (both with values), *n_flips of
- * them ordered the other way round; the first flip in a/b (indices into
- * g->rows, a better in the paper), -1 when none. */
-void tcb_ref_ordering(const tcb_ref_group *g, int m, int *n_pairs, int *n_flips, int *a, int *b);
+/* How rows i and j of a group are ordered by metric m, here and in the
+ * paper: not ordered (a value missing, or equal on either side), in the
+ * same order, or the other way round — significantly (our comparison of
+ * the two rows, Holm-adjusted within its block, is significant in our
+ * order: reports/significance.c) or within the noise (not significant, or
+ * not compared). *better_row gets the row the paper has better. */
+typedef enum tcb_ref_order {
+    TCB_REF_UNORDERED,
+    TCB_REF_AGREES,
+    TCB_REF_FLIPS_SIGNIFICANT,
+    TCB_REF_FLIPS_NOISE
+} tcb_ref_order;
+tcb_ref_order tcb_ref_order_of(const tcb_ref_group *g, int i, int j, int m, int *better_row);
 
 /* ours / paper of metric m's means; NaN when either is missing or the paper's is 0. */
 double tcb_ref_ratio(const tcb_ref_cmp_row *row, int m);

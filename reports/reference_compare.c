@@ -19,11 +19,11 @@ static const tcb_rpt_block *find_block(const tcb_rpt *r, const char *dataset, co
     return NULL;
 }
 
-static const tcb_rpt_row *find_row(const tcb_rpt *r, const tcb_ref_row *p)
+static const tcb_rpt_row *find_row(const tcb_rpt *r, const tcb_ref_row *p, const tcb_rpt_block **block, int *index)
 {
     const tcb_rpt_block *b = find_block(r, p->dataset, p->sequence);
     for (int k = 0; b && k < b->n_rows; k++)
-        if (!strcmp(b->rows[k].method, p->method)) return &b->rows[k];
+        if (!strcmp(b->rows[k].method, p->method)) return *block = b, *index = k, &b->rows[k];
     return NULL;
 }
 
@@ -48,7 +48,7 @@ static int compare_table(const tcb_ref_table *t, const tcb_rpt *r, tcb_ref_cmp_t
         for (int i = k; i < end; i++) {
             tcb_ref_cmp_row *row = &g->rows[g->n_rows++];
             row->paper = &t->rows[i];
-            row->ours = find_row(r, &t->rows[i]);
+            row->ours = find_row(r, &t->rows[i], &row->block, &row->index);
             g->n_ours += row->ours != NULL;
             for (int m = 0; m < TCB_N_METRICS; m++) out->shown[m] |= t->rows[i].has[m];
         }
@@ -61,8 +61,10 @@ static int compare_table(const tcb_ref_table *t, const tcb_rpt *r, tcb_ref_cmp_t
 
 static int names_a_cell(const tcb_ref_table *t, const tcb_rpt *r)
 {
+    const tcb_rpt_block *b;
+    int index;
     for (int k = 0; k < t->n_rows; k++)
-        if (find_row(r, &t->rows[k])) return 1;
+        if (find_row(r, &t->rows[k], &b, &index)) return 1;
     return 0;
 }
 
@@ -115,16 +117,16 @@ static int better(const tcb_ref_cmp_row *a, const tcb_ref_cmp_row *b, int m, int
     return tcb_rpt_metrics[m].lower_is_better ? sign : -sign;
 }
 
-void tcb_ref_ordering(const tcb_ref_group *g, int m, int *n_pairs, int *n_flips, int *a, int *b)
+tcb_ref_order tcb_ref_order_of(const tcb_ref_group *g, int i, int j, int m, int *better_row)
 {
-    *n_pairs = *n_flips = 0, *a = *b = -1;
-    for (int i = 0; i < g->n_rows; i++)
-        for (int j = i + 1; j < g->n_rows; j++) {
-            if (!usable(&g->rows[i], m) || !usable(&g->rows[j], m)) continue;
-            int p = better(&g->rows[i], &g->rows[j], m, 0), o = better(&g->rows[i], &g->rows[j], m, 1);
-            if (!p || !o) continue; /* a tie on either side orders nothing */
-            (*n_pairs)++;
-            if (p == o) continue;
-            if (!(*n_flips)++) *a = p > 0 ? i : j, *b = p > 0 ? j : i;
-        }
+    const tcb_ref_cmp_row *ri = &g->rows[i], *rj = &g->rows[j];
+    if (!usable(ri, m) || !usable(rj, m)) return TCB_REF_UNORDERED;
+    int p = better(ri, rj, m, 0), o = better(ri, rj, m, 1);
+    if (!p || !o) return TCB_REF_UNORDERED; /* a tie on either side orders nothing */
+    *better_row = p > 0 ? i : j;
+    if (p == o) return TCB_REF_AGREES;
+    const tcb_ref_cmp_row *ours_better = o > 0 ? ri : rj, *ours_worse = o > 0 ? rj : ri;
+    return ri->block == rj->block && tcb_rpt_beats(ri->block, ours_better->index, ours_worse->index, m)
+               ? TCB_REF_FLIPS_SIGNIFICANT
+               : TCB_REF_FLIPS_NOISE;
 }

@@ -46,17 +46,39 @@ static void value_texts_of(const tcb_ref_cmp_row *row, int m, const char *pm, va
     ratio_text(row, m, t->ratio, sizeof t->ratio);
 }
 
-/* "m_sL2: same order (3 pairs)" or "rank: 1 of 3 pairs flipped, e.g. ..." */
-static void ordering_text(const tcb_ref_group *g, int m, char *out, size_t size)
+static const char *order_name(tcb_ref_order o)
 {
-    int n, flips, a, b;
-    tcb_ref_ordering(g, m, &n, &flips, &a, &b);
+    return o == TCB_REF_AGREES ? "agrees" : o == TCB_REF_FLIPS_SIGNIFICANT ? "flips (significant)"
+                                                                          : "flips (within noise)";
+}
+
+/* "- m_sL2 ↓: agrees (3 orderings)", or a count per kind and a line per
+ * ordering the paper makes (row better in the paper first): agrees,
+ * flips (significant) or flips (within noise) (reference.h). */
+static void md_orderings(FILE *f, const tcb_ref_group *g, int m)
+{
+    int count[4] = {0}, better;
+    for (int i = 0; i < g->n_rows; i++)
+        for (int j = i + 1; j < g->n_rows; j++) count[tcb_ref_order_of(g, i, j, m, &better)]++;
+    int n = count[TCB_REF_AGREES] + count[TCB_REF_FLIPS_SIGNIFICANT] + count[TCB_REF_FLIPS_NOISE];
     const char *name = tcb_rpt_metrics[m].label;
-    if (!n) snprintf(out, size, "%s: nothing to order", name);
-    else if (!flips) snprintf(out, size, "%s: agrees (%d pair%s)", name, n, n == 1 ? "" : "s");
-    else
-        snprintf(out, size, "%s: flips %d of %d pairs, e.g. the paper has %s better than %s, this run the reverse",
-                 name, flips, n, g->rows[a].paper->paper_row, g->rows[b].paper->paper_row);
+    if (!n) {
+        fprintf(f, "- %s: nothing to order\n", name);
+        return;
+    }
+    if (count[TCB_REF_AGREES] == n) {
+        fprintf(f, "- %s: agrees (%d ordering%s)\n", name, n, n == 1 ? "" : "s");
+        return;
+    }
+    fprintf(f, "- %s: %d ordering%s: agrees %d, flips (significant) %d, flips (within noise) %d\n", name, n,
+            n == 1 ? "" : "s", count[TCB_REF_AGREES], count[TCB_REF_FLIPS_SIGNIFICANT], count[TCB_REF_FLIPS_NOISE]);
+    for (int i = 0; i < g->n_rows; i++)
+        for (int j = i + 1; j < g->n_rows; j++) {
+            tcb_ref_order o = tcb_ref_order_of(g, i, j, m, &better);
+            if (o == TCB_REF_UNORDERED) continue;
+            fprintf(f, "  - the paper has %s better than %s: %s\n", g->rows[better].paper->paper_row,
+                    g->rows[better == i ? j : i].paper->paper_row, order_name(o));
+        }
 }
 
 /* ---- Markdown ---------------------------------------------------------- */
@@ -81,13 +103,10 @@ static void md_group(FILE *f, const tcb_ref_cmp_table *t, const tcb_ref_group *g
         }
         fprintf(f, "\n");
     }
-    fprintf(f, "\nThe order of the rows, here and in the paper:\n\n");
-    for (int m = 0; m < TCB_N_METRICS; m++) {
-        char line[512];
-        if (!t->shown[m]) continue;
-        ordering_text(g, m, line, sizeof line);
-        fprintf(f, "- %s\n", line);
-    }
+    fprintf(f, "\nThe order of the rows, here and in the paper (a flip is significant when our difference "
+               "is: Holm-adjusted Wilcoxon p < 0.05 and its 95 %% interval excluding 0, comparisons.md):\n\n");
+    for (int m = 0; m < TCB_N_METRICS; m++)
+        if (t->shown[m]) md_orderings(f, g, m);
 }
 
 static void write_md(FILE *f, const tcb_ref_cmp *c)
@@ -211,13 +230,19 @@ static int write_one(const char *dir, const char *name, const char *ext, cmp_wri
 int tcb_report_reference(const char *run_dir, const char *reference, const char *out_dir, FILE *echo,
                          tcb_error *err)
 {
+    return tcb_report_reference_resampled(run_dir, reference, out_dir, 0, echo, err);
+}
+
+int tcb_report_reference_resampled(const char *run_dir, const char *reference, const char *out_dir, int resamples,
+                                   FILE *echo, tcb_error *err)
+{
     char dir[TCB_PATH_MAX], ids[TCB_REFERENCE_TABLES_MAX][16];
     int rc = out_dir ? tcb_path_join(dir, sizeof dir, err, "%s", out_dir)
                      : tcb_path_join(dir, sizeof dir, err, "%s/report", run_dir);
     tcb_reference ref;
     if (rc || (rc = tcb_reference_load(reference, &ref, err))) return rc;
     tcb_rpt r;
-    if ((rc = tcb_rpt_load(run_dir, &r, err))) {
+    if ((rc = tcb_rpt_load_compared(run_dir, resamples, &r, err))) {
         tcb_reference_free(&ref);
         return rc;
     }

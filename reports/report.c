@@ -1,4 +1,5 @@
-/* `tcbench report`: tables.md, tables.tex, results.csv, by_gap.csv, seeds.csv and three
+/* `tcbench report`: tables.md, tables.tex, results.csv, by_gap.csv, seeds.csv,
+ * comparisons.md, comparisons.tex, comparisons.csv and three
  * plots per sequence (PCK, geodesic PCK, m_sL2 by frame distance), each
  * published atomically. */
 #include "tcb/report.h"
@@ -38,7 +39,10 @@ static int write_all(const tcb_rpt *r, const char *dir, tcb_error *err)
         (rc = write_text(dir, "tables.tex", tcb_rpt_write_tex, r, err)) ||
         (rc = write_text(dir, "results.csv", tcb_rpt_write_csv, r, err)) ||
         (rc = write_text(dir, "by_gap.csv", tcb_rpt_write_gap_csv, r, err)) ||
-        (rc = write_text(dir, "seeds.csv", tcb_rpt_write_seed_csv, r, err)))
+        (rc = write_text(dir, "seeds.csv", tcb_rpt_write_seed_csv, r, err)) ||
+        (rc = write_text(dir, "comparisons.md", tcb_rpt_write_cmp_md, r, err)) ||
+        (rc = write_text(dir, "comparisons.tex", tcb_rpt_write_cmp_tex, r, err)) ||
+        (rc = write_text(dir, "comparisons.csv", tcb_rpt_write_cmp_csv, r, err)))
         return rc;
     for (int k = 0; k < r->n_blocks && !rc; k++)
         if (!(rc = write_plot(dir, "pck", tcb_rpt_plot_pck, &r->blocks[k], err)) &&
@@ -49,12 +53,18 @@ static int write_all(const tcb_rpt *r, const char *dir, tcb_error *err)
 
 int tcb_report_write(const char *run_dir, const char *out_dir, FILE *echo, tcb_error *err)
 {
+    return tcb_report_write_resampled(run_dir, out_dir, 0, echo, err);
+}
+
+int tcb_report_write_resampled(const char *run_dir, const char *out_dir, int resamples, FILE *echo,
+                               tcb_error *err)
+{
     char dir[TCB_PATH_MAX];
     int rc = out_dir ? tcb_path_join(dir, sizeof dir, err, "%s", out_dir)
                      : tcb_path_join(dir, sizeof dir, err, "%s/report", run_dir);
     if (rc) return rc;
     tcb_rpt r;
-    if ((rc = tcb_rpt_load(run_dir, &r, err))) return rc;
+    if ((rc = tcb_rpt_load_compared(run_dir, resamples, &r, err))) return rc;
     rc = write_all(&r, dir, err);
     if (!rc && echo) tcb_rpt_write_md(echo, &r);
     tcb_rpt_free(&r);

@@ -2,7 +2,9 @@
  * MEAN rows (sequence "MEAN", role "mean"). Table units, the tables'
  * precision; empty fields where the tables show "-" or a status. The
  * geodesic columns come last (geo_unreachable: vertices scored by the
- * straight-line fallback, summed over the pooled pairs).
+ * straight-line fallback, summed over the pooled pairs), then per metric
+ * the mark (<key>_mark): "best" (significantly better than every other
+ * row), "tie" (a leader tied for best) or empty (docs/protocol.md).
  *
  * by_gap.csv: one row per (dataset, sequence, method, frame distance) that
  * has pairs, for the methods whose cells are all ok.
@@ -13,7 +15,7 @@
 
 #include "reports/writers.h"
 
-static void put_field(FILE *f, const char *s)
+void tcb_rpt_csv_field(FILE *f, const char *s)
 {
     if (!strpbrk(s, ",\"\n")) {
         fputs(s, f);
@@ -35,11 +37,11 @@ static void put_num(FILE *f, int has, double x, int decimals)
 
 static void put_block(FILE *f, const tcb_rpt_block *b, const tcb_rpt_row *r)
 {
-    put_field(f, b->dataset);
+    tcb_rpt_csv_field(f, b->dataset);
     fputc(',', f);
-    put_field(f, b->sequence);
+    tcb_rpt_csv_field(f, b->sequence);
     fprintf(f, ",%s,", b->role);
-    put_field(f, r->method);
+    tcb_rpt_csv_field(f, r->method);
 }
 
 static void put_mean_std(FILE *f, const tcb_rpt_row *r, int m)
@@ -62,6 +64,7 @@ static void write_row(FILE *f, const tcb_rpt_block *b, const tcb_rpt_row *r)
     for (int m = 0; m < TCB_N_METRICS; m++)
         if (!tcb_rpt_metrics[m].paper) put_mean_std(f, r, m);
     put_num(f, r->has[TCB_M_GEO], r->geo_unreachable, 0);
+    for (int m = 0; m < TCB_N_METRICS; m++) fprintf(f, ",%s", r->best[m] ? "best" : r->tie[m] ? "tie" : "");
     fputc('\n', f);
 }
 
@@ -70,7 +73,7 @@ void tcb_rpt_write_csv(FILE *f, const tcb_rpt *r)
     fputs("dataset,sequence,role,method,status,seeds,n_pairs,sl2_x1e3_mean,sl2_x1e3_std,"
           "rank_pct_mean,rank_pct_std,auc_pct_mean,auc_pct_std,cd_x1e3_mean,cd_x1e3_std,"
           "sl2sq_x1e3_mean,sl2sq_x1e3_std,geo_x1e3_mean,geo_x1e3_std,geo_auc_pct_mean,"
-          "geo_auc_pct_std,geo_unreachable\n",
+          "geo_auc_pct_std,geo_unreachable,sl2_mark,rank_mark,auc_mark,cd_mark,geo_mark,geo_auc_mark\n",
           f);
     for (int d = 0; d < r->n_datasets; d++) {
         const tcb_rpt_dataset *ds = &r->datasets[d];

@@ -71,6 +71,33 @@ static void write_twin_note(FILE *f, const tcb_rpt_block *b)
         }
 }
 
+/* What bold and ≈ mean under a table with statistics, and what its
+ * intervals rest on (docs/protocol.md, "Statistics of a comparison"). */
+static void write_marks_legend(FILE *f, const tcb_rpt_block *b)
+{
+    if (!b->compared) return;
+    fprintf(f, "\n**bold**: best, significantly better than every other method (Holm-adjusted Wilcoxon p < "
+               "0.05 over this table's comparisons of the column, and the 95 %% bootstrap interval of the "
+               "difference excludes 0); ≈: tied for best (the leader and every method not significantly worse "
+               "than it). Differences, intervals and p-values: comparisons.md.");
+    int single = 0;
+    for (int k = 0; k < b->n_rows; k++) single |= b->rows[k].n_seeds == 1 && !strcmp(b->rows[k].status, "ok");
+    if (!strcmp(b->role, "mean")) {
+        int n = 0;
+        for (int k = 0; k < b->n_cmp && !n; k++)
+            for (int m = 0; m < TCB_N_METRICS && !n; m++) n = b->cmp[k].c.m[m].has ? b->cmp[k].c.n : 0;
+        if (n)
+            fprintf(f, " Here the test sequences (%d) are resampled%s.", n,
+                    n < 10 ? ": so few that the intervals are rough (a 95 % interval covers about 80 % with 4 "
+                             "sequences, 90 % with 10) and Wilcoxon needs 6 to reach p < 0.05"
+                           : "");
+    } else if (single) {
+        fprintf(f, " A method with one seed: its intervals cover the sampling of pairs only, not the training "
+                   "variance.");
+    }
+    fprintf(f, "\n");
+}
+
 static void write_table(FILE *f, const tcb_rpt_block *b)
 {
     fprintf(f, "| method |");
@@ -87,7 +114,7 @@ static void write_table(FILE *f, const tcb_rpt_block *b)
             char cell[128];
             tcb_rpt_cell_text(r, m, " ± ", cell, sizeof cell);
             const char *em = r->best[m] ? "**" : strcmp(r->status, "ok") ? "*" : "";
-            fprintf(f, " %s%s%s |", em, cell, em);
+            fprintf(f, " %s%s%s%s |", em, cell, em, r->tie[m] ? " ≈" : "");
         }
         fprintf(f, "\n");
     }
@@ -98,6 +125,7 @@ static void write_table(FILE *f, const tcb_rpt_block *b)
         if (!header++) fprintf(f, "\nNot ok:\n");
         fprintf(f, "- %s: %s — %s\n", r->method, r->status_text, r->message);
     }
+    write_marks_legend(f, b);
     write_unreachable_note(f, b);
     write_twin_note(f, b);
     fprintf(f, "\n");
@@ -124,7 +152,8 @@ static void write_seed_table(FILE *f, const tcb_rpt_block *b)
     int several = 0;
     for (int k = 0; k < b->n_rows; k++) several |= b->rows[k].n_by_seed > 1;
     if (!several) return;
-    fprintf(f, "Per seed (each cell's means; best per seed in **bold**):\n\n| seed | method |");
+    fprintf(f, "Per seed (each cell's means; best per seed in **bold** by its value alone, untested: which "
+               "differences are real, the table above and comparisons.md say):\n\n| seed | method |");
     for (int m = 0; m < TCB_N_METRICS; m++) fprintf(f, " %s |", tcb_rpt_metrics[m].label);
     fprintf(f, "\n|---:|:---|");
     for (int m = 0; m < TCB_N_METRICS; m++) fprintf(f, "---:|");
@@ -187,7 +216,8 @@ void tcb_rpt_write_md(FILE *f, const tcb_rpt *r)
     fprintf(f, "# tcbench results\n\n"
                "m_sL2 ×1e3, rank %%, AUC %%, CD ×1e3, as mean ± std (m_sL2 and rank over all "
                "vertices of all pairs, AUC and CD over pairs; seeds pooled). Best per column in "
-               "**bold**; \"-\": the method has no reconstruction. Beside the paper's metrics, "
+               "**bold** only when significantly better than every other method, else the leaders tied "
+               "for best marked ≈ (the legend under each table); \"-\": the method has no reconstruction. Beside the paper's metrics, "
                "the geodesic error (docs/protocol.md): m_geo ×1e3 (path length on the target "
                "mesh over sqrt(its area), over all vertices of all pairs) and AUC_geo %% (its "
                "PCK up to 0.25, over pairs); \"-\" there: cells scored before it existed.\n\n");

@@ -34,7 +34,7 @@ static void write_block(FILE *f, const tcb_rpt_block *b, const char *title)
             else if (strcmp(r->status, "ok"))
                 fprintf(f, " & \\textit{%s}", cell);
             else
-                fprintf(f, " & %s", cell);
+                fprintf(f, " & %s%s", cell, r->tie[m] ? "$^{\\approx}$" : "");
         }
         fputs(" \\\\\n", f);
     }
@@ -46,8 +46,10 @@ static void write_dataset(FILE *f, const tcb_rpt *r, const tcb_rpt_dataset *d)
     tcb_rpt_tex_escaped(f, d->name);
     fputs(": m\\_sL2 $\\times 10^{3}$, rank \\%, AUC \\%, CD $\\times 10^{3}$, and the geodesic "
           "error m\\_geo $\\times 10^{3}$ and AUC\\_geo \\% (not in the paper's protocol) (mean "
-          "$\\pm$ std); best in bold, ``-'': no reconstruction (CD) or not scored (geodesic). "
-          "MEAN: over the test sequences.}\n\\begin{tabular}{ll",
+          "$\\pm$ std); in bold the best when significantly better than every other method (Holm-adjusted "
+          "Wilcoxon $p < 0.05$ over the block's comparisons of the column and the 95\\,\\% bootstrap interval of "
+          "the difference excluding 0), else $^{\\approx}$ on the leaders tied for best; ``-'': no reconstruction "
+          "(CD) or not scored (geodesic). MEAN: over the test sequences, its intervals rough with few of them.}\n\\begin{tabular}{ll",
           f);
     for (int m = 0; m < TCB_N_METRICS; m++) fputc('c', f);
     fputs("}\n\\toprule\nSequence & Method", f);

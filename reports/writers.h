@@ -18,6 +18,14 @@ void tcb_rpt_tex_escaped(FILE *f, const char *s);
 void tcb_rpt_write_gap_csv(FILE *f, const tcb_rpt *r);
 /* seeds.csv: each cell's own means. (reports/table_csv.c) */
 void tcb_rpt_write_seed_csv(FILE *f, const tcb_rpt *r);
+/* A CSV field, quoted when it holds a comma, quote or newline. (reports/table_csv.c) */
+void tcb_rpt_csv_field(FILE *f, const char *s);
+/* comparisons.{md,tex,csv}: the blocks' pairwise differences, intervals and
+ * Holm-adjusted p-values (needs a report built with statistics).
+ * (reports/table_cmp.c) */
+void tcb_rpt_write_cmp_md(FILE *f, const tcb_rpt *r);
+void tcb_rpt_write_cmp_tex(FILE *f, const tcb_rpt *r);
+void tcb_rpt_write_cmp_csv(FILE *f, const tcb_rpt *r);
 
 /* One PNG per block, published atomically at `path`: the PCK curves, the
  * geodesic PCK curves (reports/plot_pck.c) and m_sL2 by frame distance

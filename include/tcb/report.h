@@ -2,7 +2,8 @@
  *
  * Tables are shaped like the paper's: one block per sequence, rows =
  * methods, columns m_sL2 ×1e3 ↓, rank % ↓, AUC % ↑, CD ×1e3 ↓ as mean ± std,
- * best in bold, "-" where a method has no reconstruction; a MEAN block per
+ * the best in bold when significantly best, else the leaders marked tied
+ * (tcb/compare.h), "-" where a method has no reconstruction; a MEAN block per
  * dataset averages per-sequence means and stds over TEST sequences only
  * (reference-protocol §5.6). Cells of several seeds pool their pairs. */
 #ifndef TCB_REPORT_H
@@ -21,6 +22,14 @@ extern "C" {
  * (m_sL2 by frame distance |i − j|), out_dir NULL → <run>/report, and
  * echoes the Markdown tables to `echo` if non-NULL. */
 int tcb_report_write(const char *run_dir, const char *out_dir, FILE *echo, tcb_error *err);
+/* The same with `resamples` bootstrap resamples per comparison (0: the
+ * default, TCB_BOOT_RESAMPLES = 10 000). Every report also writes
+ * comparisons.{md,tex,csv} (tcb/compare.h: per sequence and metric, each
+ * pair of methods' difference, 95 % interval and Holm-adjusted p), and
+ * bolds a best value only when it is significantly better than every other
+ * method, marking tied leaders otherwise (docs/protocol.md). */
+int tcb_report_write_resampled(const char *run_dir, const char *out_dir, int resamples, FILE *echo,
+                               tcb_error *err);
 
 /* Our tables beside a reference's (the paper's numbers: `reference` is a
  * built-in name, "iccv21", or a tcbench-reference/1 file): the tables the
@@ -31,6 +40,11 @@ int tcb_report_write(const char *run_dir, const char *out_dir, FILE *echo, tcb_e
  * echoes the Markdown to `echo` if non-NULL. */
 int tcb_report_reference(const char *run_dir, const char *reference, const char *out_dir, FILE *echo,
                          tcb_error *err);
+/* The same with `resamples` per comparison (0: the default); each ordering
+ * the paper makes is said to agree, flip significantly or flip within the
+ * noise (the comparisons of tcb_report_write_resampled). */
+int tcb_report_reference_resampled(const char *run_dir, const char *reference, const char *out_dir, int resamples,
+                                   FILE *echo, tcb_error *err);
 
 /* Baseline file "tcbench-baseline/1": per (dataset, sequence, method) the four
  * metrics in table units, plus per-metric tolerances. */

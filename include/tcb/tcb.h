@@ -24,6 +24,7 @@
 #include "tcb/frames.h"
 #include "tcb/npy.h"
 #include "tcb/score.h"
+#include "tcb/compare.h"
 #include "tcb/report.h"
 #include "tcb/binding.h"
 

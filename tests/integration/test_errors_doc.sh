@@ -313,6 +313,11 @@ mkdir -p broken && echo '{"name": ' > broken/config.json
 row "its config record unreadable" run split.json --out broken
 row "not a run directory" "$TCBENCH" inspect nowhere nearest 0
 
+# ---- comparisons
+section "Comparisons (\`tcbench compare RUN A B\`)"
+row "an unknown method label" "$TCBENCH" compare runs/grid nearest nricpp
+row "a sequence without cells of both" "$TCBENCH" compare runs/grid nearest nricp --sequence horse
+
 # ---- command line
 section "Command-line flags (every command; checked before anything is read)"
 row "\`--threads 0\`" run split.json --threads 0
@@ -322,6 +327,7 @@ row "\`--count 0\`" "$TCBENCH" frames runs/split nearest --count 0
 row "\`--samples 0\`" "$TCBENCH" datasets align data/quadruped_walk --out r.json --samples 0
 row "\`datasets distortion\` of neither a synthetic sequence nor a directory" "$TCBENCH" datasets distortion nowhere
 row "\`--lock-timeout 0\`" run split.json --lock-timeout 0
+row "\`--resamples 10\` (a bootstrap needs more)" "$TCBENCH" report runs/split --resamples 10
 row "a single-value flag given twice" "$TCBENCH" score split.json --dataset synth --sequence quadruped_walk --pred pred --pred other --name files
 row "\`--root\` naming a dataset twice" run split.json --root synth=a --root synth=b
 

@@ -8,7 +8,11 @@
  *     xb.bin      float64 [S_B][P]
  *     draws.bin   int32   [RESAMPLES][S_A + S_B + P]  in the draw order
  *     result.txt  "estimate lo hi resamples", %.17g
- * (tests/integration/test_bootstrap_numpy.sh compares them with numpy). */
+ * (tests/integration/test_bootstrap_numpy.sh compares them with numpy).
+ *     bootstrap_dump S_A S_B P SEED RESAMPLES OUT_DIR LABEL IN_DIR
+ * takes xa.bin and xb.bin from IN_DIR instead (a comparison's per-pair
+ * values, tests/integration/test_compare.sh) and draws from the stream
+ * LABEL ("compare/sl2"), as tcb_compare_cells does. */
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -20,6 +24,17 @@ static void fill(double *x, int seeds, int pairs, double offset, tcb_rng *rng)
     for (int s = 0; s < seeds; s++)
         for (int p = 0; p < pairs; p++)
             x[(size_t)s * pairs + p] = (double)(p % 11) + offset + 0.4 * tcb_rng_normal(rng);
+}
+
+static int read_file(const char *dir, const char *name, void *data, size_t bytes)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "rb");
+    int ok = f && fread(data, 1, bytes, f) == bytes;
+    if (f) fclose(f);
+    if (!ok) fprintf(stderr, "bootstrap_dump: %s: cannot read %zu bytes\n", path, bytes);
+    return ok ? 0 : 1;
 }
 
 static int write_file(const char *dir, const char *name, const void *data, size_t bytes)
@@ -35,8 +50,8 @@ static int write_file(const char *dir, const char *name, const void *data, size_
 
 int main(int argc, char **argv)
 {
-    if (argc != 7) {
-        fprintf(stderr, "usage: bootstrap_dump S_A S_B P SEED RESAMPLES OUT_DIR\n");
+    if (argc != 7 && argc != 9) {
+        fprintf(stderr, "usage: bootstrap_dump S_A S_B P SEED RESAMPLES OUT_DIR [LABEL IN_DIR]\n");
         return 2;
     }
     int sa = atoi(argv[1]), sb = atoi(argv[2]), pairs = atoi(argv[3]), resamples = atoi(argv[5]);
@@ -53,9 +68,13 @@ int main(int argc, char **argv)
     tcb_rng_seed_stream(&rng, seed, "bootstrap_dump/inputs");
     fill(xa, sa, pairs, 0.25, &rng);
     fill(xb, sb, pairs, 0.0, &rng);
+    if (argc == 9 && (read_file(argv[8], "xa.bin", xa, sizeof *xa * (size_t)sa * pairs) ||
+                      read_file(argv[8], "xb.bin", xb, sizeof *xb * (size_t)sb * pairs)))
+        return 1;
     tcb_boot_result r;
     tcb_error err = {0};
-    int rc = tcb_bootstrap_paired(xa, sa, xb, sb, pairs, seed, "bootstrap_dump", resamples, draws, &r, &err);
+    int rc = tcb_bootstrap_paired(xa, sa, xb, sb, pairs, seed, argc == 9 ? argv[7] : "bootstrap_dump", resamples,
+                                  draws, &r, &err);
     if (rc) fprintf(stderr, "bootstrap_dump: %s\n", err.msg);
     char text[256];
     int len = rc ? 0 : snprintf(text, sizeof text, "%.17g %.17g %.17g %d\n", r.estimate, r.lo, r.hi, r.resamples);

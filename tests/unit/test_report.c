@@ -111,18 +111,19 @@ static expect expected_mean(const int *seqs, int n, int m)
 
 static const int DECIMALS[N_COLS] = {2, 2, 2, 3, 2, 2};
 
-/* "| AN | **1.00 ± 0.20** | … |" with `bold` a 6-bit mask and `no_cd` "-". */
-static void md_row(const char *method, const expect *e, int bold, int no_cd, char *out,
+/* "| AN | **1.00 ± 0.20** | 3.00 ± 1.41 ≈ | … |" with `bold` and `tie` 6-bit
+ * masks (significantly best; tied for best) and `no_cd` "-". */
+static void md_row(const char *method, const expect *e, int bold, int tie, int no_cd, char *out,
                    size_t size)
 {
     size_t used = (size_t)snprintf(out, size, "| %s |", method);
     for (int j = 0; j < N_COLS; j++) {
-        const char *b = bold >> j & 1 ? "**" : "";
+        const char *b = bold >> j & 1 ? "**" : "", *t = tie >> j & 1 ? " ≈" : "";
         if (j == 3 && no_cd)
             used += (size_t)snprintf(out + used, size - used, " - |");
         else
-            used += (size_t)snprintf(out + used, size - used, " %s%.*f ± %.*f%s |", b, DECIMALS[j],
-                                     e->mean[j], DECIMALS[j], e->std[j], b);
+            used += (size_t)snprintf(out + used, size - used, " %s%.*f ± %.*f%s%s |", b, DECIMALS[j],
+                                     e->mean[j], DECIMALS[j], e->std[j], b, t);
     }
 }
 
@@ -206,14 +207,19 @@ static void test_md_sequence_block_bold_and_dash(void **state)
     char *horse = section(f->md, "### anim / horse");
     char row[512];
     expect an = expected(1, 0), nn = expected(1, 1), dsr = expected(1, 2);
-    /* DSR is best everywhere; rank ties across methods, so all bold. NN and
-     * DSR ran one of the heading's two seeds, which their rows say. */
-    md_row("AN", &an, 0x2, 0, row, sizeof row);
+    /* DSR leads everywhere, but on 2 pairs no difference can be significant
+     * (Wilcoxon's smallest p with n = 2 is 0.5): no bold, every row tied for
+     * best where it has a value (NN has no CD). NN and DSR ran one of the
+     * heading's two seeds, which their rows say. test_compare's
+     * test_report_marks checks bold where differences are real. */
+    md_row("AN", &an, 0, 0x3F, 0, row, sizeof row);
     assert_contains(horse, row);
-    md_row("NN (seed 0)", &nn, 0x2, 1, row, sizeof row);
+    md_row("NN (seed 0)", &nn, 0, 0x37, 1, row, sizeof row);
     assert_contains(horse, row);
-    md_row("DSR (seed 0)", &dsr, 0x3F, 0, row, sizeof row);
+    md_row("DSR (seed 0)", &dsr, 0, 0x3F, 0, row, sizeof row);
     assert_contains(horse, row);
+    assert_contains(horse, "≈: tied for best");
+    assert_contains(horse, "A method with one seed: its intervals cover the sampling of pairs only");
     assert_null(strstr(horse, "| AN ("));
     assert_contains(horse, "role: test · pairs: 2 · seeds: 0, 1");
     /* Links to the block's plots, which test_pngs_are_valid finds on disk. */
@@ -243,15 +249,17 @@ static void test_md_mean_over_test_sequences_only(void **state)
     const int tests[] = {1, 2}, all[] = {0, 1, 2};
     char row[512];
     expect an = expected_mean(tests, 2, 0), nn = expected_mean(tests, 2, 1);
-    /* AN best on m_sL2 and AUC, rank tied with NN; CD is AN's alone (NN has
-     * none, DSR failed), so not bold. */
-    md_row("AN", &an, 0x37, 0, row, sizeof row);
+    /* AN leads on m_sL2 and AUC, rank equal to NN's, but two sequences
+     * cannot make a difference significant: AN and NN tied; CD is AN's
+     * alone (NN has none, DSR failed), so not marked. */
+    md_row("AN", &an, 0, 0x37, 0, row, sizeof row);
     assert_contains(mean, row);
-    md_row("NN", &nn, 0x2, 1, row, sizeof row);
+    md_row("NN", &nn, 0, 0x37, 1, row, sizeof row);
     assert_contains(mean, row);
+    assert_contains(mean, "Here the test sequences (2) are resampled: so few that the intervals are rough");
     /* The validation sequence must not leak into the mean. */
     expect with_cat = expected_mean(all, 3, 0);
-    md_row("AN", &with_cat, 0x37, 0, row, sizeof row);
+    md_row("AN", &with_cat, 0, 0x37, 0, row, sizeof row);
     assert_null(strstr(mean, row));
     /* A method failed on one test sequence gets no MEAN numbers. */
     assert_contains(mean, "| DSR | *failed* | *failed* | *failed* | *failed* | *failed* | *failed* |");
@@ -285,7 +293,8 @@ static void test_md_per_seed_table(void **state)
     fixture *f = *state;
     char *horse = section(f->md, "### anim / horse");
     char row[512];
-    assert_contains(horse, "Per seed (each cell's means; best per seed in **bold**):");
+    assert_contains(horse, "Per seed (each cell's means; best per seed in **bold** by its value alone, untested: "
+                           "which differences are real, the table above and comparisons.md say):");
     /* Seed 0: every method, DSR best, rank tied; seed 1: AN alone, with
      * nothing to be better than, so nothing bold. */
     expect an0 = expected_seeds(1, 0, 0, 1), an1 = expected_seeds(1, 0, 1, 1);
@@ -311,7 +320,7 @@ static void test_md_per_seed_table(void **state)
 
 /* ------------------------------------------------------------------ CSV */
 
-#define CSV_MAX_FIELDS 22
+#define CSV_MAX_FIELDS 28
 typedef struct csv_row {
     char field[CSV_MAX_FIELDS][64];
 } csv_row;
@@ -359,7 +368,7 @@ static const csv_row *find_csv(const csv_row *rows, int n, const char *seq, cons
 }
 
 /* results.csv: the paper's metrics from field 7, sL2² at 15 and 16, the
- * geodesic ones from 17, the fallback count at 21. */
+ * geodesic ones from 17, the fallback count at 21, the marks from 22. */
 static void assert_csv_values(const csv_row *r, const expect *e, int has_cd)
 {
     for (int j = 0; j < N_COLS; j++) {
@@ -381,13 +390,15 @@ static void test_csv_parses_back(void **state)
 {
     fixture *f = *state;
     int n;
-    csv_row *rows = read_csv(f, "results.csv", 22, &n);
+    csv_row *rows = read_csv(f, "results.csv", 28, &n);
     /* header + 4 sequences × 3 methods + anim's 3 MEAN rows */
     assert_int_equal(n, 1 + 12 + 3);
     assert_string_equal(rows[0].field[7], "sl2_x1e3_mean");
     assert_string_equal(rows[0].field[15], "sl2sq_x1e3_mean");
     assert_string_equal(rows[0].field[17], "geo_x1e3_mean");
     assert_string_equal(rows[0].field[21], "geo_unreachable");
+    assert_string_equal(rows[0].field[22], "sl2_mark");
+    assert_string_equal(rows[0].field[27], "geo_auc_mark");
     expect an = expected(1, 0), nn = expected(1, 1);
     const csv_row *r = find_csv(rows, n, "horse", "AN");
     assert_string_equal(r->field[2], "test");
@@ -396,6 +407,9 @@ static void test_csv_parses_back(void **state)
     assert_string_equal(r->field[6], "2");
     assert_csv_values(r, &an, 1);
     assert_csv_values(find_csv(rows, n, "horse", "NN"), &nn, 0);
+    /* 2 pairs: nothing significant, every row tied for best (NN has no CD) */
+    assert_string_equal(r->field[22], "tie");
+    assert_string_equal(find_csv(rows, n, "horse", "NN")->field[25], "");
     const int tests[] = {1, 2};
     expect mean = expected_mean(tests, 2, 0);
     r = find_csv(rows, n, "MEAN", "AN");
@@ -520,10 +534,12 @@ static void test_tex_uses_booktabs(void **state)
     assert_contains(tex, "m\\_sL2 $\\downarrow$");
     assert_contains(tex, "m\\_geo $\\downarrow$ & AUC\\_geo $\\uparrow$ \\\\");
     assert_contains(tex, "\\begin{tabular}{llcccccc}");
+    /* DSR leads, tied for best (2 pairs: nothing can be significant) */
     expect dsr = expected(1, 2);
-    char best[128];
-    snprintf(best, sizeof best, "\\textbf{%.2f $\\pm$ %.2f}", dsr.mean[0], dsr.std[0]);
-    assert_contains(tex, best);
+    char tied[128];
+    snprintf(tied, sizeof tied, " & %.2f $\\pm$ %.2f$^{\\approx}$ &", dsr.mean[0], dsr.std[0]);
+    assert_contains(tex, tied);
+    assert_null(strstr(tex, "\\textbf{"));
     free(tex);
 }
 
@@ -561,7 +577,7 @@ static void test_pngs_are_valid(void **state)
         n++;
     }
     closedir(d);
-    assert_int_equal(n, 5 + 3 * N_SEQS);
+    assert_int_equal(n, 8 + 3 * N_SEQS);
 }
 
 /* The Markdown row of `method` in md (up to its line's end). */
@@ -606,11 +622,13 @@ static void test_old_cells_show_dash(void **state)
     char *md = read_all(path);
     /* (OLD and NEW ran one of the block's two seeds, which their rows say) */
     char *old = md_line(md, "OLD (seed 0)"), *neu = md_line(md, "NEW (seed 0)"), *mix = md_line(md, "MIX");
-    /* OLD: best on the paper's m_sL2, "-" for the geodesic error */
-    if (strncmp(old, "| OLD (seed 0) | **", 19) || !ends_with(old, " | - | - |")) fail_msg("%s", old);
+    /* OLD: leads on the paper's m_sL2 (tied for best: 2 pairs cannot make it
+     * significant), "-" for the geodesic error */
+    if (strncmp(old, "| OLD (seed 0) | ", 17) || !strstr(old, " ≈ |") || !ends_with(old, " | - | - |"))
+        fail_msg("%s", old);
     if (!ends_with(mix, " | - | - |")) fail_msg("%s", mix);
-    /* NEW alone has geodesic numbers, with nothing to compare: not bold */
-    if (strstr(neu, "| - |") || ends_with(neu, "** |")) fail_msg("%s", neu);
+    /* NEW alone has geodesic numbers, with nothing to compare: not marked */
+    if (strstr(neu, "| - |") || ends_with(neu, "** |") || ends_with(neu, "≈ |")) fail_msg("%s", neu);
     snprintf(path, sizeof path, "%s/report/pck_geo_anim_horse.png", dir);
     assert_true(tcb_is_file(path));
     free(old), free(neu), free(mix), free(md);
