@@ -128,7 +128,8 @@ static int load_header(const cJSON *root, const char *path, tcb_split *out, tcb_
                                             "seed",   "clip_frames", "n_clips", "starts", NULL};
     const char *format, *role;
     long long n_frames, seed, count;
-    int rc = tcb_json_str(root, "format", path, 1, NULL, &format, err);
+    int rc = tcb_json_expect_object(root, path, err);
+    if (!rc) rc = tcb_json_str(root, "format", path, 1, NULL, &format, err);
     int clips = !rc && strcmp(format, CLIPS_FORMAT) == 0;
     if (!rc && !clips && strcmp(format, SPLIT_FORMAT) != 0)
         return tcb_fail(err, TCB_ERR_INPUT, "%s.format: expected \"%s\" or \"%s\", got \"%s\"", path,

@@ -311,7 +311,7 @@ static void test_md_per_seed_table(void **state)
 
 /* ------------------------------------------------------------------ CSV */
 
-#define CSV_MAX_FIELDS 22
+#define CSV_MAX_FIELDS 24
 typedef struct csv_row {
     char field[CSV_MAX_FIELDS][64];
 } csv_row;
@@ -381,13 +381,14 @@ static void test_csv_parses_back(void **state)
 {
     fixture *f = *state;
     int n;
-    csv_row *rows = read_csv(f, "results.csv", 22, &n);
+    csv_row *rows = read_csv(f, "results.csv", 24, &n);
     /* header + 4 sequences × 3 methods + anim's 3 MEAN rows */
     assert_int_equal(n, 1 + 12 + 3);
     assert_string_equal(rows[0].field[7], "sl2_x1e3_mean");
     assert_string_equal(rows[0].field[15], "sl2sq_x1e3_mean");
     assert_string_equal(rows[0].field[17], "geo_x1e3_mean");
     assert_string_equal(rows[0].field[21], "geo_unreachable");
+    assert_string_equal(rows[0].field[22], "corr_x1e3_mean");
     expect an = expected(1, 0), nn = expected(1, 1);
     const csv_row *r = find_csv(rows, n, "horse", "AN");
     assert_string_equal(r->field[2], "test");
@@ -469,7 +470,7 @@ static void test_seed_csv_one_row_per_cell(void **state)
 {
     fixture *f = *state;
     int n;
-    csv_row *rows = read_csv(f, "seeds.csv", 13, &n);
+    csv_row *rows = read_csv(f, "seeds.csv", 14, &n);
     assert_string_equal(rows[0].field[4], "seed");
     int n_cells = 0;
     for (int m = 0; m < N_METHODS; m++) n_cells += N_SEQS * METHODS[m].n_seeds;
@@ -518,8 +519,8 @@ static void test_tex_uses_booktabs(void **state)
     assert_contains(tex, "\\midrule");
     assert_contains(tex, "\\bottomrule");
     assert_contains(tex, "m\\_sL2 $\\downarrow$");
-    assert_contains(tex, "m\\_geo $\\downarrow$ & AUC\\_geo $\\uparrow$ \\\\");
-    assert_contains(tex, "\\begin{tabular}{llcccccc}");
+    assert_contains(tex, "m\\_geo $\\downarrow$ & AUC\\_geo $\\uparrow$ & Corr $\\downarrow$ \\\\");
+    assert_contains(tex, "\\begin{tabular}{llccccccc}");
     expect dsr = expected(1, 2);
     char best[128];
     snprintf(best, sizeof best, "\\textbf{%.2f $\\pm$ %.2f}", dsr.mean[0], dsr.std[0]);
@@ -609,8 +610,9 @@ static void test_old_cells_show_dash(void **state)
     /* OLD: best on the paper's m_sL2, "-" for the geodesic error */
     if (strncmp(old, "| OLD (seed 0) | **", 19) || !ends_with(old, " | - | - |")) fail_msg("%s", old);
     if (!ends_with(mix, " | - | - |")) fail_msg("%s", mix);
-    /* NEW alone has geodesic numbers, with nothing to compare: not bold */
-    if (strstr(neu, "| - |") || ends_with(neu, "** |")) fail_msg("%s", neu);
+    /* NEW alone has geodesic numbers, with nothing to compare: not bold;
+     * no cell scored clips: "-" under Corr (the last column) */
+    if (!ends_with(neu, " | - |") || strstr(neu, "| - | - |") || strstr(neu, "** | - |")) fail_msg("%s", neu);
     snprintf(path, sizeof path, "%s/report/pck_geo_anim_horse.png", dir);
     assert_true(tcb_is_file(path));
     free(old), free(neu), free(mix), free(md);
