@@ -79,10 +79,13 @@ void tcb_split_free(tcb_split *s)
 {
     free(s->pairs);
     free(s->blocks);
+    free(s->starts);
     s->pairs = NULL;
     s->blocks = NULL;
+    s->starts = NULL;
     s->n_pairs = 0;
     s->n_blocks = 0;
+    s->n_clips = 0;
 }
 
 static void describe_count(int n_blocks, char *out, size_t size)
@@ -140,6 +143,12 @@ static int disagreement(const tcb_split *s, const tcb_split *want, char *what, c
     } else if (s->n_pairs != want->n_pairs) {
         snprintf(what, size, "n_pairs");
         snprintf(have, size, "%d", s->n_pairs), snprintf(wanted, size, "%d", want->n_pairs);
+    } else if (s->clip_frames != want->clip_frames) {
+        snprintf(what, size, "clip_frames");
+        snprintf(have, size, "%d", s->clip_frames), snprintf(wanted, size, "%d", want->clip_frames);
+    } else if (s->n_clips != want->n_clips) {
+        snprintf(what, size, "n_clips");
+        snprintf(have, size, "%d", s->n_clips), snprintf(wanted, size, "%d", want->n_clips);
     } else if (s->seed != want->seed) {
         snprintf(what, size, "seed");
         snprintf(have, size, "%" PRIu64, s->seed), snprintf(wanted, size, "%" PRIu64, want->seed);
@@ -155,15 +164,21 @@ int tcb_split_obtain(const char *path, const char *dataset, const char *sequence
 {
     /* Making first also validates the request before any file is touched. */
     int rc = tcb_split_make(dataset, sequence, role, n_frames, blocks, n_blocks, n_pairs, seed, out, err);
-    if (rc) return rc;
+    return rc ? rc : tcb_split_obtain_made(path, out, err);
+}
+
+int tcb_split_obtain_made(const char *path, tcb_split *out, tcb_error *err)
+{
+    int rc;
     if (!tcb_is_file(path)) {
         rc = tcb_split_save(path, out, err);
         if (rc) tcb_split_free(out);
         return rc;
     }
     tcb_split want = *out; /* keeps the requested blocks */
-    want.pairs = NULL;
     free(out->pairs);
+    free(out->starts);
+    want.pairs = NULL, want.starts = NULL;
     rc = tcb_split_load(path, out, err);
     char what[160], have[160], wanted[160];
     if (!rc && disagreement(out, &want, what, have, wanted, sizeof have)) {

@@ -223,6 +223,24 @@ static void reconstruction_cd(const tcb_cell_job *job, void *self, int i, int j,
     free(pts);
 }
 
+/* The method's transfer of frame i's GT vertices to frame j into moved,
+ * checked finite; k numbers the pair in messages. */
+static int transfer_pair(const tcb_cell_job *job, void *self, int i, int j, int k, tcb_rng *rng, float *moved,
+                         tcb_error *merr)
+{
+    const tcb_sequence *seq = job->seq;
+    int nv = seq->n_verts;
+    int rc = job->ops->transfer(self, seq, i, j, tcb_seq_frame(seq, i), nv, moved, rng, merr);
+    if (rc) {
+        ensure_error(merr, rc);
+        tcb_error_prefix(merr, "transfer %d->%d (pair %d): ", i, j, k);
+        return rc;
+    }
+    if (!tcb_all_finite(moved, (size_t)nv * 3))
+        return tcb_fail(merr, TCB_ERR_NUMERIC, "transfer %d->%d (pair %d): returned a non-finite point", i, j, k);
+    return TCB_OK;
+}
+
 /* Pair k of the split into rec and the summary; with `cap`, its metrics
  * and reconstructions are kept there too. Failures land in merr (the
  * method's) or herr (the harness's); the caller checks both. */
@@ -231,24 +249,12 @@ static void eval_pair(const tcb_cell_job *job, void *self, int k, eval_bufs *b,
                       tcb_error *merr, tcb_error *herr)
 {
     const tcb_sequence *seq = job->seq;
-    int nv = seq->n_verts;
     int i = job->split->pairs[2 * k], j = job->split->pairs[2 * k + 1];
     char label[TCB_PATH_MAX];
     snprintf(label, sizeof label, "eval/%s/%s/%d", job->dataset->name, seq->name, k);
     tcb_rng rng;
     tcb_rng_seed_stream(&rng, (uint64_t)job->seed, label);
-
-    int rc = job->ops->transfer(self, seq, i, j, tcb_seq_frame(seq, i), nv, b->moved, &rng, merr);
-    if (rc) {
-        ensure_error(merr, rc);
-        tcb_error_prefix(merr, "transfer %d->%d (pair %d): ", i, j, k);
-        return;
-    }
-    if (!tcb_all_finite(b->moved, (size_t)nv * 3)) {
-        tcb_fail(merr, TCB_ERR_NUMERIC, "transfer %d->%d (pair %d): returned a non-finite point",
-                 i, j, k);
-        return;
-    }
+    if (transfer_pair(job, self, i, j, k, &rng, b->moved, merr)) return;
     double cd = NAN;
     if (job->ops->reconstruct) {
         double cd_i = 0, cd_j = 0;
@@ -268,31 +274,104 @@ static void eval_pair(const tcb_cell_job *job, void *self, int k, eval_bufs *b,
     if (cap) cap->i = i, cap->j = j, cap->metrics = pm;
 }
 
+#define CLIP_PAIRS (TCB_CLIP_FRAMES - 1)
+
+/* Clip c of job->clips: its frame 0 (start) transferred to each of its
+ * frames 1 .. 16, and the tracking error of each (the transferred points
+ * as the method gave them, not projected: DynoSurf scores its predicted
+ * vertices) into rec. Each transfer draws from a stream of its own frames,
+ * the same whether or not the pairs are evaluated too. */
+static void eval_clip(const tcb_cell_job *job, void *self, int c, int first, float *moved, tcb_clip_record *rec,
+                      tcb_error *merr)
+{
+    const tcb_sequence *seq = job->seq;
+    int s = job->clips->starts[c];
+    rec->start = s;
+    rec->corr = 0;
+    for (int t = 1; t < TCB_CLIP_FRAMES; t++) {
+        char label[TCB_PATH_MAX];
+        snprintf(label, sizeof label, "clip/%s/%s/%d/%d", job->dataset->name, seq->name, s, t);
+        tcb_rng rng;
+        tcb_rng_seed_stream(&rng, (uint64_t)job->seed, label);
+        if (transfer_pair(job, self, s, s + t, first + t - 1, &rng, moved, merr)) return;
+        rec->err[t - 1] = tcb_corr_frame(moved, tcb_seq_frame(seq, s + t), seq->n_verts);
+        rec->corr += rec->err[t - 1] / CLIP_PAIRS;
+    }
+}
+
+/* The clips' pairs (s, s + 1) .. (s, s + 16) of every clip in order, for
+ * prepare_pairs; malloc'ed [n_clips * 16][2], NULL when out of memory. */
+static int *clip_pairs(const tcb_split *clips)
+{
+    int *pairs = malloc((size_t)clips->n_clips * CLIP_PAIRS * 2 * sizeof *pairs);
+    for (int c = 0; pairs && c < clips->n_clips; c++)
+        for (int t = 1; t < TCB_CLIP_FRAMES; t++) {
+            int m = c * CLIP_PAIRS + t - 1;
+            pairs[2 * m] = clips->starts[c], pairs[2 * m + 1] = clips->starts[c] + t;
+        }
+    return pairs;
+}
+
+/* A stop request ends the evaluation between two pairs. */
+static int stop_requested(const tcb_cell_job *job, int done, int total, tcb_error *herr)
+{
+    if (!job->interrupted || !job->interrupted(job->interrupt_arg)) return 0;
+    tcb_fail(herr, TCB_ERR_INTERRUPTED, "stopped at pair %d of %d of the evaluation (the fitted model is kept)",
+             done, total);
+    return 1;
+}
+
+/* The clip protocol's clips after the split's pairs; their pairs are
+ * numbered on from the split's (prepare_pairs, messages). */
+static void evaluate_clips(const tcb_cell_job *job, void *self, eval_bufs *b, tcb_cell_result *c,
+                           const char *label, int total, tcb_error *merr, tcb_error *herr)
+{
+    const tcb_split *clips = job->clips;
+    int first = job->split->n_pairs;
+    int *pairs = clip_pairs(clips);
+    c->clips = calloc((size_t)clips->n_clips, sizeof *c->clips);
+    if (!pairs || !c->clips) {
+        free(pairs);
+        tcb_fail(herr, TCB_ERR_NOMEM, "out of memory for %d clips", clips->n_clips);
+        return;
+    }
+    tcb_cell_prepare_pairs(job, self, pairs, first, clips->n_clips * CLIP_PAIRS, merr);
+    free(pairs);
+    snprintf(c->clips_path, sizeof c->clips_path, "%s", job->clips_path);
+    c->clips_seed = clips->seed;
+    for (int k = 0; k < clips->n_clips && !merr->code; k++) {
+        int done = first + k * CLIP_PAIRS;
+        if (stop_requested(job, done, total, herr)) return;
+        eval_clip(job, self, k, done, b->moved, &c->clips[k], merr);
+        tcb_stat_push(&c->summary.corr, c->clips[k].corr);
+        tcb_report_progress(&job->reporter, done + CLIP_PAIRS, total, label);
+    }
+    c->n_clips = clips->n_clips;
+}
+
 static void evaluate(const tcb_cell_job *job, void *self, tcb_cell_result *c, tcb_error *merr,
                      tcb_error *herr)
 {
     const tcb_split *split = job->split;
+    int total = split->n_pairs + (job->clips ? job->clips->n_clips * CLIP_PAIRS : 0);
     eval_bufs b;
     if (eval_bufs_init(job->seq, &b, herr)) return;
-    c->pairs = calloc((size_t)split->n_pairs, sizeof *c->pairs);
+    c->pairs = calloc((size_t)split->n_pairs + 1, sizeof *c->pairs);
     if (!c->pairs) {
         tcb_fail(herr, TCB_ERR_NOMEM, "out of memory for %d pairs", split->n_pairs);
     } else {
         char label[TCB_CELL_LABEL_MAX];
         tcb_cell_label(label, sizeof label, job->dataset->name, job->seq->name,
                        job->method->label, job->seed);
-        tcb_report_progress(&job->reporter, 0, split->n_pairs, label);
-        prepare_split_pairs(job, self, 0, split->n_pairs, merr);
+        tcb_report_progress(&job->reporter, 0, total, label);
+        if (split->n_pairs > 0) prepare_split_pairs(job, self, 0, split->n_pairs, merr);
         for (int k = 0; k < split->n_pairs && !merr->code && !herr->code; k++) {
-            if (job->interrupted && job->interrupted(job->interrupt_arg)) {
-                tcb_fail(herr, TCB_ERR_INTERRUPTED, "stopped at pair %d of %d of the evaluation (the fitted model is kept)",
-                         k, split->n_pairs);
-                break;
-            }
+            if (stop_requested(job, k, total, herr)) break;
             eval_pair(job, self, k, &b, &c->pairs[k], &c->summary, NULL, merr, herr);
-            tcb_report_progress(&job->reporter, k + 1, split->n_pairs, label);
+            tcb_report_progress(&job->reporter, k + 1, total, label);
         }
         c->n_pairs = split->n_pairs;
+        if (job->clips && !merr->code && !herr->code) evaluate_clips(job, self, &b, c, label, total, merr, herr);
     }
     eval_bufs_free(&b);
 }
@@ -303,8 +382,11 @@ static void record_failure(tcb_cell_result *c, const tcb_error *merr)
     c->status = merr->code == TCB_ERR_NUMERIC ? TCB_CELL_DIVERGED : TCB_CELL_FAILED;
     snprintf(c->message, sizeof c->message, "%s", merr->msg);
     free(c->pairs);
+    free(c->clips);
     c->pairs = NULL;
+    c->clips = NULL;
     c->n_pairs = 0;
+    c->n_clips = 0;
     tcb_summary_init(&c->summary);
 }
 

@@ -21,7 +21,9 @@ static const char *const top_keys[] = {"name", "output", "splits_dir", "cache_di
                                        "reference", NULL};
 static const char *const reference_keys[] = {"source", "tables", NULL};
 static const char *const eval_keys[] = {"pairs", "split_seed", "pool_size", "pool_seed",
-                                        "input_points", NULL};
+                                        "input_points", "protocol", "clips", NULL};
+/* Indexed by the bit's position: TCB_PROTOCOL_PAIRS, TCB_PROTOCOL_CLIPS. */
+const char *const tcb_config_protocol_names[] = {"pairs", "clips", NULL};
 static const char *const synthetic_keys[] = {"name", "source", "seed", "frames", "normalization",
                                              "align_rotation", "align_samples", "sampling", "sequences", NULL};
 static const char *const objdir_keys[] = {"name", "source", "root", "optional", "normalization",
@@ -417,6 +419,32 @@ static int parse_plugins(const cJSON *root, const char *origin, tcb_config *c, t
     return TCB_OK;
 }
 
+/* One protocol name's bit, 0 when unknown. */
+static int protocol_bit(const cJSON *v)
+{
+    for (int k = 0; cJSON_IsString(v) && tcb_config_protocol_names[k]; k++)
+        if (!strcmp(v->valuestring, tcb_config_protocol_names[k])) return 1 << k;
+    return 0;
+}
+
+/* "protocol": a name, or a non-empty list of distinct names; default pairs. */
+static int parse_protocol(const cJSON *ev, const char *where, tcb_config *c, tcb_error *err)
+{
+    const cJSON *p = cJSON_GetObjectItemCaseSensitive(ev, "protocol");
+    c->protocols = p ? protocol_bit(p) : TCB_PROTOCOL_PAIRS;
+    for (const cJSON *e = cJSON_IsArray(p) ? p->child : NULL; e; e = e->next) {
+        int bit = protocol_bit(e);
+        c->protocols = bit && !(c->protocols & bit) && c->protocols != -1 ? c->protocols | bit : -1;
+    }
+    if (c->protocols > 0) return TCB_OK;
+    char *text = cJSON_PrintUnformatted(p);
+    int rc = tcb_fail(err, TCB_ERR_INPUT,
+                      "%s.protocol: expected \"pairs\", \"clips\" or a list of them (each once), got %.200s",
+                      where, text ? text : "?");
+    cJSON_free(text);
+    return rc;
+}
+
 static int parse_evaluation(const cJSON *root, const char *origin, tcb_config *c, tcb_error *err)
 {
     char w[WHERE_MAX];
@@ -424,8 +452,12 @@ static int parse_evaluation(const cJSON *root, const char *origin, tcb_config *c
     const cJSON *ev = cJSON_GetObjectItemCaseSensitive(root, "evaluation");
     cJSON *empty = NULL;
     if (!ev) ev = empty = cJSON_CreateObject();
-    long long pairs, split_seed, pool, pool_seed, input;
+    long long pairs, split_seed, pool, pool_seed, input, clips;
     int rc = tcb_json_expect_keys(ev, w, eval_keys, err);
+    if (!rc) rc = parse_protocol(ev, w, c, err);
+    if (!rc && cJSON_HasObjectItem(ev, "clips") && !(c->protocols & TCB_PROTOCOL_CLIPS))
+        rc = tcb_fail(err, TCB_ERR_INPUT, "%s.clips: only with the clip protocol (\"protocol\": \"clips\")", w);
+    if (!rc) rc = tcb_json_int(ev, "clips", w, 0, TCB_DEFAULT_EVAL_CLIPS, 1, 100000, &clips, err);
     if (!rc)
         rc = tcb_json_int(ev, "pairs", w, 0, TCB_DEFAULT_EVAL_PAIRS, 1, 1000000, &pairs, err);
     if (!rc) rc = tcb_json_int(ev, "split_seed", w, 0, 2021, 0, LLONG_MAX, &split_seed, err);
@@ -439,6 +471,7 @@ static int parse_evaluation(const cJSON *root, const char *origin, tcb_config *c
     if (rc) return rc;
     c->eval_pairs = (int)pairs;
     c->split_seed = (uint64_t)split_seed;
+    c->eval_clips = (int)clips;
     c->pool_size = (int)pool;
     c->pool_seed = (uint64_t)pool_seed;
     c->input_points = (int)input;

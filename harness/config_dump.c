@@ -13,6 +13,14 @@ static cJSON *dump_evaluation(const tcb_config *c)
     cJSON_AddNumberToObject(ev, "pool_size", c->pool_size);
     cJSON_AddNumberToObject(ev, "pool_seed", (double)c->pool_seed);
     cJSON_AddNumberToObject(ev, "input_points", c->input_points);
+    /* Only when not the default, so that the record of a run directory made
+     * before the clip protocol still reads as the same settings. */
+    if (c->protocols == TCB_PROTOCOL_PAIRS) return ev;
+    if (c->protocols == TCB_PROTOCOL_CLIPS)
+        cJSON_AddStringToObject(ev, "protocol", "clips");
+    else
+        cJSON_AddItemToObject(ev, "protocol", cJSON_CreateStringArray(tcb_config_protocol_names, 2));
+    cJSON_AddNumberToObject(ev, "clips", c->eval_clips);
     return ev;
 }
 

@@ -22,6 +22,7 @@
 /* Value names of the config's enums, NULL-terminated; indexed by the enum. */
 extern const char *const tcb_config_source_names[];   /* tcb_source */
 extern const char *const tcb_config_norm_names[];     /* tcb_normalization */
+extern const char *const tcb_config_protocol_names[]; /* by TCB_PROTOCOL_* bit position */
 extern const char *const tcb_config_sampling_names[]; /* with_replacement: 0, 1 */
 
 /* The config with every default filled in, pretty-printed; malloc'ed, NULL
@@ -171,6 +172,12 @@ int tcb_harness_split_path(const tcb_config *cfg, const tcb_dataset_spec *d, con
 int tcb_harness_obtain_split(const tcb_config *cfg, const tcb_dataset_spec *d,
                              const tcb_sequence_spec *s, const tcb_sequence *seq, char *path,
                              size_t size, tcb_split *split, tcb_error *err);
+/* <splits_dir>/<dataset>/<sequence>.clips.json into *clips (the clip
+ * protocol's start frames, tcb_clips_obtain; made once, then reused and
+ * checked like the pairs' split); its path in path[size]. */
+int tcb_harness_obtain_clips(const tcb_config *cfg, const tcb_dataset_spec *d,
+                             const tcb_sequence_spec *s, const tcb_sequence *seq, char *path,
+                             size_t size, tcb_split *clips, tcb_error *err);
 /* A cell's work directory <run>/work/<dataset>/<sequence>/<label>/seed_<s>
  * and its model checkpoint <work>/model.ckpt, both [TCB_PATH_MAX]. */
 int tcb_harness_work_paths(const char *run_dir, const char *dataset, const char *sequence,
@@ -196,6 +203,10 @@ typedef struct tcb_cell_job {
     tcb_reporter reporter;
     int (*interrupted)(const void *arg); /* may be NULL: see tcb_fit_ctx */
     const void *interrupt_arg;
+    /* The clip protocol's split, or NULL (no clips: a job that does not set
+     * it). Without the pairs protocol, split->n_pairs is 0. */
+    const tcb_split *clips;
+    const char *clips_path;
 } tcb_cell_job;
 
 /* The record of a cell's model checkpoint (<checkpoint>.fit.json): the

@@ -121,7 +121,12 @@ static void sequence_header(plan_walk *w, const tcb_dataset_spec *d, const char 
         tcb_run_missing_root_text(d, why, sizeof why);
         fprintf(w->out, "dataset %s: %s%s\n", d->name, why, d->optional ? " (optional: skipped by a run)" : "");
     }
-    w->q = (tcb_cost_query){0, 0, w->cfg->eval_pairs, w->cfg->threads};
+    /* The clip protocol's transfers count as pairs (16 a clip; at most
+     * the configured clips, fewer on a short sequence). */
+    const tcb_config *c = w->cfg;
+    int pairs = (c->protocols & TCB_PROTOCOL_PAIRS ? c->eval_pairs : 0) +
+                (c->protocols & TCB_PROTOCOL_CLIPS ? c->eval_clips * (TCB_CLIP_FRAMES - 1) : 0);
+    w->q = (tcb_cost_query){0, 0, pairs, c->threads};
     probe(d, seq, &w->q.n_frames, &w->q.n_verts);
     if (w->q.n_frames)
         fprintf(w->out, "%s/%s: %d frames, %d vertices, %d pairs\n", d->name, seq, w->q.n_frames, w->q.n_verts,

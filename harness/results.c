@@ -126,6 +126,32 @@ static void add_summary(builder *b, cJSON *root, const tcb_summary *s)
     for (int k = 0; geo_pck && k < TCB_GEO_PCK_STEPS; k++)
         append(b, geo_pck, num_or_null(s->geo_pck[k]));
     add_num(b, o, "geo_unreachable", s->geo_unreachable);
+    if (s->corr.n > 0) add_stat(b, o, "corr", &s->corr);
+}
+
+/* The clip protocol's split and rows, when the cell scored clips. */
+static void add_clips(builder *b, cJSON *root, const tcb_cell_result *c)
+{
+    if (c->n_clips == 0) return;
+    static const char *const columns[] = {"start", "corr", "err"};
+    cJSON *o = add(b, root, "clips", cJSON_CreateObject());
+    if (!o) return;
+    add_str(b, o, "path", c->clips_path);
+    add_num(b, o, "seed", (double)c->clips_seed);
+    add_num(b, o, "clip_frames", TCB_CLIP_FRAMES);
+    add_num(b, o, "n_clips", c->n_clips);
+    add(b, o, "columns", cJSON_CreateStringArray(columns, 3));
+    cJSON *rows = add(b, o, "rows", cJSON_CreateArray());
+    for (int k = 0; rows && k < c->n_clips && b->ok; k++) {
+        const tcb_clip_record *r = &c->clips[k];
+        cJSON *row = cJSON_CreateArray();
+        if (!append(b, rows, row) || !append(b, row, num_or_null(r->start)) ||
+            !append(b, row, num_or_null(r->corr)))
+            return;
+        cJSON *err = cJSON_CreateArray();
+        if (!append(b, row, err)) return;
+        for (int t = 0; t < TCB_CLIP_FRAMES - 1; t++) append(b, err, num_or_null(r->err[t]));
+    }
 }
 
 void tcb_pair_record_row(const tcb_pair_record *r, double *v)
@@ -166,6 +192,9 @@ static int check_for_save(const char *path, const tcb_cell_result *c, tcb_error 
         return tcb_fail(err, TCB_ERR_INTERNAL, "%s: invalid cell status %d", path, (int)c->status);
     if (c->n_pairs < 0 || (c->n_pairs > 0 && !c->pairs))
         return tcb_fail(err, TCB_ERR_INTERNAL, "%s: %d pairs without records", path, c->n_pairs);
+    if (c->n_clips < 0 || (c->n_clips > 0 && !c->clips) || (double)c->clips_seed > TCB_JSON_INT_MAX)
+        return tcb_fail(err, TCB_ERR_INTERNAL, "%s: %d clips without records, or a clip seed past 2^53", path,
+                        c->n_clips);
     if ((double)c->split_seed > TCB_JSON_INT_MAX)
         return tcb_fail(err, TCB_ERR_INPUT, "%s: split seed %llu exceeds 2^53", path,
                         c->split_seed);
@@ -229,6 +258,7 @@ cJSON *tcb_cell_to_json(const char *path, const tcb_cell_result *c, tcb_error *e
     }
     add_summary(&b, root, &c->summary);
     add_pairs(&b, root, c);
+    add_clips(&b, root, c);
     if (!b.ok) {
         cJSON_Delete(root);
         tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", path);
@@ -253,7 +283,10 @@ void tcb_cell_free(tcb_cell_result *c)
     if (!c) return;
     free(c->params_json);
     free(c->pairs);
+    free(c->clips);
     c->params_json = NULL;
     c->pairs = NULL;
+    c->clips = NULL;
     c->n_pairs = 0;
+    c->n_clips = 0;
 }

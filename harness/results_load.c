@@ -16,16 +16,18 @@ static const char *const TOP_KEYS[] = {
     "format",       "dataset",         "sequence", "role",        "method",
     "method_impl",  "params",          "seed",     "status",      "message",
     "git_revision", "tcbench_version", "timings",  "peak_rss_kb", "split",
-    "summary",      "pair_columns",    "pairs",    NULL};
+    "summary",      "pair_columns",    "pairs",    "clips",       NULL};
 static const char *const TIMING_KEYS[] = {"load_s", "fit_s", "eval_s", NULL};
 static const char *const SPLIT_KEYS[] = {"path", "seed", "n_pairs", NULL};
 static const char *const SUMMARY_KEYS[] = {"n_pairs", "sl2",     "sl2sq",   "rank",
                                            "auc",     "cd",      "pck",     "geo",
-                                           "geo_auc", "geo_pck", "geo_unreachable", NULL};
+                                           "geo_auc", "geo_pck", "geo_unreachable", "corr", NULL};
 /* The summary's geodesic keys: all or none (none in a cell written before
  * the geodesic error). */
 static const char *const GEO_KEYS[] = {"geo", "geo_auc", "geo_pck", "geo_unreachable", NULL};
 static const char *const STAT_KEYS[] = {"n", "mean", "m2", NULL};
+/* The clip protocol's (absent in a cell without clips). */
+static const char *const CLIPS_KEYS[] = {"path", "seed", "clip_frames", "n_clips", "columns", "rows", NULL};
 
 /* Key paths for messages ("file: summary.sl2.mean"); a path too long for
  * the buffer is cut, which only shortens a message. */
@@ -154,6 +156,7 @@ static int load_summary(const cJSON *root, const char *where, tcb_summary *s, tc
     else if ((rc = load_stat(o, "cd", sub, &s->cd, err)))
         return rc;
     if ((rc = load_curve(o, "pck", sub, TCB_PCK_STEPS, s->pck, err))) return rc;
+    if (cJSON_HasObjectItem(o, "corr") && (rc = load_stat(o, "corr", sub, &s->corr, err))) return rc;
     return load_summary_geodesic(o, sub, s, err);
 }
 
@@ -251,6 +254,56 @@ static int load_pairs(const cJSON *root, int n_cols, const char *where, tcb_cell
     return TCB_OK;
 }
 
+/* A clip's row: [start, corr, [err_1, …, err_16]]. */
+static int load_clip(const cJSON *row, const char *at, tcb_clip_record *r, tcb_error *err)
+{
+    const int n_err = TCB_CLIP_FRAMES - 1;
+    const cJSON *e = cJSON_IsArray(row) && cJSON_GetArraySize(row) == 3 ? row->child->next->next : NULL;
+    if (!e || !cJSON_IsArray(e) || cJSON_GetArraySize(e) != n_err)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: expected [start, corr, [%d errors]]", at, n_err);
+    int rc = pair_index(row->child, at, &r->start, err);
+    if (!rc) rc = value_or_null(row->child->next, at, &r->corr, err);
+    int t = 0;
+    for (const cJSON *v = e->child; v && !rc; v = v->next, t++) rc = value_or_null(v, at, &r->err[t], err);
+    return rc;
+}
+
+/* The optional "clips" (none: n_clips 0). */
+static int load_clips(const cJSON *root, const char *where, tcb_cell_result *c, tcb_error *err)
+{
+    if (!cJSON_HasObjectItem(root, "clips")) return TCB_OK;
+    static const char *const columns[] = {"start", "corr", "err", NULL};
+    char sub[TCB_ERRMSG_MAX];
+    const cJSON *o, *cols, *rows;
+    long long v;
+    int rc = object_key(root, "clips", where, CLIPS_KEYS, &o, sub, sizeof sub, err);
+    if (rc || (rc = copy_str(o, "path", sub, c->clips_path, sizeof c->clips_path, err)) ||
+        (rc = tcb_json_int(o, "seed", sub, 1, 0, 0, (long long)TCB_JSON_INT_MAX, &v, err)))
+        return rc;
+    c->clips_seed = (unsigned long long)v;
+    if ((rc = tcb_json_int(o, "clip_frames", sub, 1, 0, TCB_CLIP_FRAMES, TCB_CLIP_FRAMES, &v, err)) ||
+        (rc = tcb_json_int(o, "n_clips", sub, 1, 0, 1, INT_MAX, &v, err)))
+        return rc;
+    cols = cJSON_GetObjectItemCaseSensitive(o, "columns");
+    int k = 0, ok = cJSON_IsArray(cols) && cJSON_GetArraySize(cols) == 3;
+    for (const cJSON *e = ok ? cols->child : NULL; e; e = e->next, k++)
+        ok = ok && cJSON_IsString(e) && !strcmp(e->valuestring, columns[k]);
+    if (!ok) return tcb_fail(err, TCB_ERR_INPUT, "%s.columns: expected [\"start\", \"corr\", \"err\"]", sub);
+    rows = cJSON_GetObjectItemCaseSensitive(o, "rows");
+    if (!cJSON_IsArray(rows) || cJSON_GetArraySize(rows) != v)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.rows: expected an array of n_clips (%lld) rows", sub, v);
+    c->clips = calloc((size_t)v, sizeof *c->clips);
+    if (!c->clips) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", sub);
+    c->n_clips = (int)v;
+    k = 0;
+    for (const cJSON *row = rows->child; row && !rc; row = row->next, k++) {
+        char at[TCB_ERRMSG_MAX];
+        key_path(at, sizeof at, "%s.rows[%d]", sub, k);
+        rc = load_clip(row, at, &c->clips[k], err);
+    }
+    return rc;
+}
+
 static int load_params(const cJSON *root, const char *where, tcb_cell_result *c, tcb_error *err)
 {
     char sub[TCB_ERRMSG_MAX];
@@ -331,8 +384,12 @@ static int cell_from_json(const cJSON *root, const char *path, tcb_cell_result *
         (rc = load_timings_split(root, path, c, err)) ||
         (rc = load_summary(root, path, &c->summary, err)) ||
         (rc = load_pair_columns(root, path, &n_cols, err)) ||
-        (rc = load_pairs(root, n_cols, path, c, err)))
+        (rc = load_pairs(root, n_cols, path, c, err)) || (rc = load_clips(root, path, c, err)))
         return rc;
+    /* The summary's Corr is over the cell's clips, and only with clips. */
+    if ((c->status == TCB_CELL_OK || c->n_clips == 0) && c->summary.corr.n != c->n_clips)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.summary.corr: %s, but the cell has %d clips", path,
+                        c->summary.corr.n > 0 ? "over other clips" : "absent", c->n_clips);
     /* A finished ok cell scored every pair of its split. */
     if (c->status == TCB_CELL_OK && c->summary.n_pairs != c->n_pairs)
         return tcb_fail(err, TCB_ERR_INPUT, "%s.summary.n_pairs: %d, but the cell has %d pairs",

@@ -165,6 +165,16 @@ int tcb_harness_obtain_split(const tcb_config *cfg, const tcb_dataset_spec *d,
                             cfg->eval_pairs, cfg->split_seed, split, err);
 }
 
+int tcb_harness_obtain_clips(const tcb_config *cfg, const tcb_dataset_spec *d,
+                             const tcb_sequence_spec *s, const tcb_sequence *seq, char *path,
+                             size_t size, tcb_split *clips, tcb_error *err)
+{
+    int rc = tcb_path_join(path, size, err, "%s/%s/%s.clips.json", cfg->splits_dir, d->name, s->name);
+    if (rc) return rc;
+    return tcb_clips_obtain(path, d->name, s->name, s->role, seq->n_frames, seq->blocks, seq->n_blocks,
+                            cfg->eval_clips, cfg->split_seed, clips, err);
+}
+
 int tcb_harness_work_paths(const char *run_dir, const char *dataset, const char *sequence,
                            const char *label, int seed, char *work, char *ckpt, tcb_error *err)
 {
@@ -180,8 +190,8 @@ int tcb_harness_work_paths(const char *run_dir, const char *dataset, const char 
  * (a crash, a time-out, bad output: no result) is computed again, *keep 0.
  * (The split's path is not compared: the same split may be reached through
  * another working directory.) */
-static int check_existing(const char *path, const tcb_method_spec *m, const tcb_split *split, int *keep,
-                          tcb_error *err)
+static int check_existing(const char *path, const tcb_method_spec *m, const tcb_split *split,
+                          const tcb_split *clips, int *keep, tcb_error *err)
 {
     tcb_cell_result c;
     int rc = tcb_cell_load(path, &c, err);
@@ -195,6 +205,8 @@ static int check_existing(const char *path, const tcb_method_spec *m, const tcb_
                        : c.split_seed != split->seed               ? "split seed"
                        : c.status == TCB_CELL_OK && c.n_pairs != split->n_pairs
                            ? "number of pairs"
+                       : c.status == TCB_CELL_OK && c.n_clips != (clips ? clips->n_clips : 0)
+                           ? "number of clips"
                            : NULL;
     *keep = c.status != TCB_CELL_FAILED;
     tcb_cell_free(&c);
@@ -209,8 +221,10 @@ static int check_existing(const char *path, const tcb_method_spec *m, const tcb_
 typedef struct seq_ctx {
     const tcb_dataset_spec *dataset;
     const tcb_sequence *seq;
-    const tcb_split *split;
+    const tcb_split *split;     /* n_pairs 0 when the protocol has no pairs */
     const char *split_path;
+    const tcb_split *clips;     /* NULL when the protocol has no clips */
+    const char *clips_path;
     double load_s;
 } seq_ctx;
 
@@ -253,6 +267,8 @@ static int run_cell(const run_state *st, const seq_ctx *sc, const tcb_method_spe
         .reporter = st->opts->reporter,
         .interrupted = st->opts->interrupted,
         .interrupt_arg = st->opts->interrupt_arg,
+        .clips = sc->clips,
+        .clips_path = sc->clips_path,
     };
     char label[TCB_CELL_LABEL_MAX];
     tcb_cell_label(label, sizeof label, sc->dataset->name, sc->seq->name, m->label, seed);
@@ -295,7 +311,7 @@ static int kept_result(const run_state *st, const tcb_method_spec *m, const seq_
 {
     *keep = 0;
     if (st->opts->force || !tcb_is_file(path)) return TCB_OK;
-    int rc = check_existing(path, m, sc->split, keep, err);
+    int rc = check_existing(path, m, sc->split, sc->clips, keep, err);
     if (!rc && *keep) st->stats->cells_skipped++;
     if (!rc && *keep) rc = clear_stale_lock(st, path, err);
     return rc;
@@ -381,16 +397,23 @@ static int run_sequence(const run_state *st, const tcb_dataset_spec *d, const tc
 {
     if (!sequence_wanted(st, d, first)) return TCB_OK;
     tcb_sequence seq = {0};
-    tcb_split split = {0};
-    char split_path[TCB_PATH_MAX];
+    tcb_split split = {0}, clips = {0};
+    char split_path[TCB_PATH_MAX], clips_path[TCB_PATH_MAX] = "";
     double t0 = tcb_now_seconds();
     tcb_report_log(&st->opts->reporter, TCB_LOG_INFO, "%s/%s: loading", d->name, s->name);
     int rc = tcb_harness_load_sequence(st->cfg, d, s->name, &st->opts->reporter, &seq, err);
     if (rc) return rc;
-    seq_ctx sc = {d, &seq, &split, split_path, tcb_now_seconds() - t0};
+    int with_clips = st->cfg->protocols & TCB_PROTOCOL_CLIPS;
+    seq_ctx sc = {d, &seq, &split, split_path, with_clips ? &clips : NULL, clips_path, tcb_now_seconds() - t0};
     rc = tcb_harness_obtain_split(st->cfg, d, s, &seq, split_path, sizeof split_path, &split, err);
+    /* Clips only: the cells score no pairs (the pairs' split is still the
+     * sequence's, named in the cells). */
+    if (!rc && !(st->cfg->protocols & TCB_PROTOCOL_PAIRS)) split.n_pairs = 0;
+    if (!rc && with_clips)
+        rc = tcb_harness_obtain_clips(st->cfg, d, s, &seq, clips_path, sizeof clips_path, &clips, err);
     if (!rc) rc = run_cells(st, &sc, first, err);
     tcb_split_free(&split);
+    tcb_split_free(&clips);
     tcb_sequence_free(&seq);
     return rc;
 }

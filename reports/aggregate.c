@@ -16,6 +16,8 @@ const tcb_rpt_metric_def tcb_rpt_metrics[TCB_N_METRICS] = {
     /* ×1e3 as m_sL2: a fraction of sqrt(area), good methods' ~0.01-0.05. */
     {"geo", "m_geo ↓", "m\\_geo $\\downarrow$", 1e3, 2, 1, 0},
     {"geo_auc", "AUC_geo ↑", "AUC\\_geo $\\uparrow$", 1e2, 2, 0, 0},
+    /* ×1e3 as m_sL2 (the papers print it raw: their 0.010 is 10.00 here). */
+    {"corr", "Corr ↓", "Corr $\\downarrow$", 1e3, 2, 1, 0},
 };
 
 static int same_block(const tcb_cell_result *a, const tcb_cell_result *b)
@@ -84,6 +86,7 @@ static int build_seeds(const tcb_cell_result *cells, int n, tcb_rpt_row *r, tcb_
         set_seed_stat(s, TCB_M_RANK, &c->summary.rank);
         set_seed_stat(s, TCB_M_AUC, &c->summary.auc);
         set_seed_stat(s, TCB_M_CD, &c->summary.cd);
+        set_seed_stat(s, TCB_M_CORR, &c->summary.corr);
         if (!all_geodesic(&c->summary)) continue;
         set_seed_stat(s, TCB_M_GEO, &c->summary.geo);
         set_seed_stat(s, TCB_M_GEO_AUC, &c->summary.geo_auc);
@@ -142,6 +145,7 @@ static int build_row(const tcb_cell_result *cells, int n, tcb_rpt_row *r, tcb_er
     set_stat(r, TCB_M_RANK, &pooled.rank);
     set_stat(r, TCB_M_AUC, &pooled.auc);
     set_stat(r, TCB_M_CD, &pooled.cd);
+    set_stat(r, TCB_M_CORR, &pooled.corr);
     r->sl2sq_mean = pooled.sl2sq.mean * 1e3;
     r->sl2sq_std = tcb_stat_std(&pooled.sl2sq) * 1e3;
     for (int s = 0; s < TCB_PCK_STEPS; s++) r->pck[s] = pooled.pck[s] * 100.0;

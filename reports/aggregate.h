@@ -7,7 +7,8 @@
  * pooled cell is "ok"; otherwise it carries the status, so a failure never
  * hides behind a number. The geodesic columns (tcb/geodesic.h, not the
  * paper's) show "-" unless every pooled pair has them: a cell written
- * before the geodesic error existed has none. */
+ * before the geodesic error existed has none. Corr (×1e3, the clip
+ * protocol's) shows "-" for cells that scored no clips. */
 #ifndef TCB_REPORTS_AGGREGATE_H
 #define TCB_REPORTS_AGGREGATE_H
 
@@ -25,6 +26,7 @@ typedef enum tcb_rpt_metric {
     TCB_M_CD,
     TCB_M_GEO,      /* the geodesic error and its AUC: tcbench's addition */
     TCB_M_GEO_AUC,
+    TCB_M_CORR,     /* the clip protocol's tracking error (DynoSurf/PDG/Neu-PiG), over clips */
     TCB_N_METRICS
 } tcb_rpt_metric;
 

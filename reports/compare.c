@@ -12,7 +12,7 @@
 #include "tcb/wilcoxon.h"
 
 _Static_assert((int)TCB_CMP_N_METRICS == (int)TCB_N_METRICS, "compare.h's metrics are the report's columns");
-_Static_assert((int)TCB_CMP_SL2 == (int)TCB_M_SL2 && (int)TCB_CMP_CD == (int)TCB_M_CD &&
+_Static_assert((int)TCB_CMP_SL2 == (int)TCB_M_SL2 && (int)TCB_CMP_CD == (int)TCB_M_CD && (int)TCB_CMP_CORR == (int)TCB_M_CORR &&
                    (int)TCB_CMP_GEO_AUC == (int)TCB_M_GEO_AUC,
                "compare.h's metrics are in the report's column order");
 
@@ -20,8 +20,8 @@ const char *tcb_cmp_metric_key(int metric) { return tcb_rpt_metrics[metric].key;
 
 const char *tcb_cmp_metric_label(int metric)
 {
-    static const char *const labels[TCB_CMP_N_METRICS] = {"m_sL2 ×1e3", "rank %",      "AUC %",
-                                                          "CD ×1e3",    "m_geo ×1e3", "AUC_geo %"};
+    static const char *const labels[TCB_CMP_N_METRICS] = {"m_sL2 ×1e3", "rank %",     "AUC %",   "CD ×1e3",
+                                                          "m_geo ×1e3", "AUC_geo %", "Corr ×1e3"};
     return labels[metric];
 }
 
@@ -43,17 +43,29 @@ static double pair_value(const tcb_pair_record *p, int m)
     }
 }
 
-/* Cells c[0..n) of metric m into x[s][p] in table units; 0 when a value is
- * missing (the metric is then not compared). */
-static int fill(const tcb_cell_result *c, int n, int m, double *x)
+/* The units metric m is paired over: clips for Corr, else pairs. */
+static int units(const tcb_cell_result *c, int m) { return m == TCB_M_CORR ? c->n_clips : c->n_pairs; }
+
+static double unit_value(const tcb_cell_result *c, int u, int m)
 {
-    int pairs = c[0].n_pairs;
-    for (int s = 0; s < n; s++)
-        for (int p = 0; p < pairs; p++) {
-            double v = pair_value(&c[s].pairs[p], m);
+    return m == TCB_M_CORR ? c->clips[u].corr : pair_value(&c->pairs[u], m);
+}
+
+/* Cells c[0..n) of metric m into x[s][u] in table units over the units
+ * of `first` (their count); 0 when a cell has other units or a value is
+ * missing (the metric is then not compared). */
+static int fill(const tcb_cell_result *c, int n, int m, const tcb_cell_result *first, double *x)
+{
+    int count = units(first, m);
+    if (count < 1) return 0;
+    for (int s = 0; s < n; s++) {
+        if (units(&c[s], m) != count) return 0;
+        for (int u = 0; u < count; u++) {
+            double v = unit_value(&c[s], u, m);
             if (!isfinite(v)) return 0;
-            x[(size_t)s * pairs + p] = v * tcb_rpt_metrics[m].scale;
+            x[(size_t)s * count + u] = v * tcb_rpt_metrics[m].scale;
         }
+    }
     return 1;
 }
 
@@ -65,6 +77,18 @@ static int same_split(const tcb_cell_result *ref, const tcb_cell_result *c, tcb_
                !strcmp(ref->sequence, c->sequence);
     for (int p = 0; same && p < ref->n_pairs; p++)
         same = ref->pairs[p].i == c->pairs[p].i && ref->pairs[p].j == c->pairs[p].j;
+    /* Clips, when both scored them: the same clip split too. */
+    if (same && ref->n_clips && c->n_clips) {
+        same = !strcmp(ref->clips_path, c->clips_path) && ref->clips_seed == c->clips_seed &&
+               ref->n_clips == c->n_clips;
+        for (int k = 0; same && k < ref->n_clips; k++) same = ref->clips[k].start == c->clips[k].start;
+        if (!same)
+            return tcb_fail(err, TCB_ERR_INPUT,
+                            "compare: %s/%s %s seed %d and %s/%s %s seed %d were not scored on the same clips "
+                            "(%s seed %llu vs %s seed %llu): they cannot be paired",
+                            ref->dataset, ref->sequence, ref->method, ref->seed, c->dataset, c->sequence,
+                            c->method, c->seed, ref->clips_path, ref->clips_seed, c->clips_path, c->clips_seed);
+    }
     if (same) return TCB_OK;
     return tcb_fail(err, TCB_ERR_INPUT,
                     "compare: %s/%s %s seed %d and %s/%s %s seed %d were not scored on the same pairs "
@@ -79,8 +103,8 @@ static int check_cells(const tcb_cell_result *a, int na, const tcb_cell_result *
     if (na < 1 || nb < 1)
         return tcb_fail(err, TCB_ERR_INPUT, "compare: needs at least one ok cell of each method (%d and %d)",
                         na, nb);
-    if (a[0].n_pairs < 1)
-        return tcb_fail(err, TCB_ERR_INPUT, "compare: %s/%s %s seed %d has no pairs", a[0].dataset,
+    if (a[0].n_pairs < 1 && a[0].n_clips < 1)
+        return tcb_fail(err, TCB_ERR_INPUT, "compare: %s/%s %s seed %d has no pairs and no clips", a[0].dataset,
                         a[0].sequence, a[0].method, a[0].seed);
     for (int k = 0; k < na + nb; k++) {
         const tcb_cell_result *c = k < na ? &a[k] : &b[k - na];
@@ -144,15 +168,18 @@ int tcb_compare_cells(const tcb_cell_result *a, int na, const tcb_cell_result *b
     memset(out, 0, sizeof *out);
     int rc = check_cells(a, na, b, nb, err);
     if (rc) return rc;
-    int pairs = a[0].n_pairs;
-    double *xa = malloc(sizeof *xa * (size_t)pairs * (size_t)(na + nb + 2));
+    int most = a[0].n_pairs > a[0].n_clips ? a[0].n_pairs : a[0].n_clips;
+    double *xa = malloc(sizeof *xa * (size_t)most * (size_t)(na + nb + 2));
     if (!xa) return tcb_fail(err, TCB_ERR_NOMEM, "compare: out of memory");
-    double *xb = xa + (size_t)pairs * na, *scratch = xb + (size_t)pairs * nb;
-    *out = (tcb_cmp){.seeds_a = na, .seeds_b = nb, .n = pairs, .single_seed = na == 1 || nb == 1,
+    *out = (tcb_cmp){.seeds_a = na, .seeds_b = nb, .n = a[0].n_pairs, .single_seed = na == 1 || nb == 1,
                      .resamples = resamples ? resamples : TCB_BOOT_RESAMPLES};
-    for (int m = 0; m < TCB_N_METRICS && !rc; m++)
-        if (fill(a, na, m, xa) && fill(b, nb, m, xb))
-            rc = compare_metric(xa, na, xb, nb, pairs, m, resamples, scratch, &out->m[m], err);
+    for (int m = 0; m < TCB_N_METRICS && !rc; m++) {
+        int count = units(&a[0], m);
+        double *xb = xa + (size_t)count * na, *scratch = xb + (size_t)count * nb;
+        if (!fill(a, na, m, &a[0], xa) || !fill(b, nb, m, &a[0], xb)) continue;
+        rc = compare_metric(xa, na, xb, nb, count, m, resamples, scratch, &out->m[m], err);
+        if (m == TCB_M_CORR) out->n_clips = count;
+    }
     free(xa);
     return rc;
 }

@@ -61,9 +61,11 @@ static void write_row(FILE *f, const tcb_rpt_block *b, const tcb_rpt_row *r)
     /* sL2² is a squared distance like CD: same precision. */
     put_num(f, r->has[TCB_M_SL2], r->sl2sq_mean, tcb_rpt_metrics[TCB_M_CD].decimals);
     put_num(f, r->has[TCB_M_SL2], r->sl2sq_std, tcb_rpt_metrics[TCB_M_CD].decimals);
-    for (int m = 0; m < TCB_N_METRICS; m++)
+    for (int m = 0; m < TCB_M_CORR; m++)
         if (!tcb_rpt_metrics[m].paper) put_mean_std(f, r, m);
     put_num(f, r->has[TCB_M_GEO], r->geo_unreachable, 0);
+    /* Corr, added after geo_unreachable, goes after it; then the marks. */
+    for (int m = TCB_M_CORR; m < TCB_N_METRICS; m++) put_mean_std(f, r, m);
     for (int m = 0; m < TCB_N_METRICS; m++) fprintf(f, ",%s", r->best[m] ? "best" : r->tie[m] ? "tie" : "");
     fputc('\n', f);
 }
@@ -73,7 +75,8 @@ void tcb_rpt_write_csv(FILE *f, const tcb_rpt *r)
     fputs("dataset,sequence,role,method,status,seeds,n_pairs,sl2_x1e3_mean,sl2_x1e3_std,"
           "rank_pct_mean,rank_pct_std,auc_pct_mean,auc_pct_std,cd_x1e3_mean,cd_x1e3_std,"
           "sl2sq_x1e3_mean,sl2sq_x1e3_std,geo_x1e3_mean,geo_x1e3_std,geo_auc_pct_mean,"
-          "geo_auc_pct_std,geo_unreachable,sl2_mark,rank_mark,auc_mark,cd_mark,geo_mark,geo_auc_mark\n",
+          "geo_auc_pct_std,geo_unreachable,corr_x1e3_mean,corr_x1e3_std,sl2_mark,rank_mark,auc_mark,"
+          "cd_mark,geo_mark,geo_auc_mark,corr_mark\n",
           f);
     for (int d = 0; d < r->n_datasets; d++) {
         const tcb_rpt_dataset *ds = &r->datasets[d];
@@ -105,7 +108,7 @@ void tcb_rpt_write_gap_csv(FILE *f, const tcb_rpt *r)
 void tcb_rpt_write_seed_csv(FILE *f, const tcb_rpt *r)
 {
     fputs("dataset,sequence,role,method,seed,status,n_pairs,sl2_x1e3_mean,rank_pct_mean,"
-          "auc_pct_mean,cd_x1e3_mean,geo_x1e3_mean,geo_auc_pct_mean\n",
+          "auc_pct_mean,cd_x1e3_mean,geo_x1e3_mean,geo_auc_pct_mean,corr_x1e3_mean\n",
           f);
     for (int k = 0; k < r->n_blocks; k++)
         for (int i = 0; i < r->blocks[k].n_rows; i++) {

@@ -22,7 +22,11 @@
  *
  * The pairs are paired by position: both sides' cells must carry the same
  * split (path, seed) and the same (i, j) at every position (a split may
- * hold the same (i, j) twice); otherwise the comparison is refused.
+ * hold the same (i, j) twice); otherwise the comparison is refused. Corr
+ * (the clip protocol's tracking error) is compared the same way over
+ * clips instead of pairs: one value per clip, paired by position in the
+ * same clip split (path, seed, starts); it is compared only when every
+ * cell of both sides scored clips.
  *
  * With one seed on either side the seed level resamples nothing for it:
  * the interval then covers the sampling of pairs only, not the training
@@ -53,7 +57,11 @@ extern "C" {
 #define TCB_CMP_ALPHA 0.05
 
 /* Metrics compared, in the report's column order. */
-enum { TCB_CMP_SL2, TCB_CMP_RANK, TCB_CMP_AUC, TCB_CMP_CD, TCB_CMP_GEO, TCB_CMP_GEO_AUC, TCB_CMP_N_METRICS };
+enum {
+    TCB_CMP_SL2, TCB_CMP_RANK, TCB_CMP_AUC, TCB_CMP_CD, TCB_CMP_GEO, TCB_CMP_GEO_AUC,
+    TCB_CMP_CORR, /* per clip of the clip protocol, not per pair */
+    TCB_CMP_N_METRICS
+};
 
 typedef struct tcb_cmp_metric {
     int has;                 /* 0: a side has no value on some pair (no reconstruction,
@@ -67,6 +75,7 @@ typedef struct tcb_cmp_metric {
 typedef struct tcb_cmp {
     int seeds_a, seeds_b;    /* cells of each side (1 and 1 across sequences) */
     int n;                   /* pairs, or sequences when over_sequences */
+    int n_clips;             /* clips behind Corr (0: Corr not compared) */
     int over_sequences;      /* a MEAN row: the sequences were resampled */
     int single_seed;         /* a side has one seed: training variance left out */
     int resamples;

@@ -23,7 +23,11 @@
  *                                        "params" merge into the methods with that label
  *                                        or method name; the run goes to <output>/<variant>
  *     "evaluation": { "pairs": 500, "split_seed": 2021, "pool_size": 10000,
- *                     "pool_seed": 0, "input_points": 2500 },
+ *                     "pool_seed": 0, "input_points": 2500,
+ *                     "protocol": "pairs" | "clips" | ["pairs", "clips"],   the paper's
+ *                                        pairs (default), the 17-frame clips of DynoSurf/PDG/
+ *                                        Neu-PiG (Corr; docs/protocol.md), or both
+ *                     "clips": 10 },     clips per sequence (clip protocol only)
  *     "datasets": [
  *       { "name": "synth", "source": "synthetic", "seed": 0, "frames": 0,
  *         "normalization": "first_frame" | "none" | "per_frame",
@@ -105,6 +109,9 @@ int tcb_method_runs_on(const tcb_method_spec *m, const char *dataset);
 
 #define TCB_REFERENCE_TABLES_MAX 16
 
+/* The evaluation protocols, a set ("evaluation.protocol"). */
+enum { TCB_PROTOCOL_PAIRS = 1, TCB_PROTOCOL_CLIPS = 2 };
+
 typedef struct tcb_config {
     char path[TCB_PATH_MAX];
     char name[64];
@@ -118,6 +125,8 @@ typedef struct tcb_config {
     int threads;
     int eval_pairs;
     uint64_t split_seed;
+    int protocols;           /* TCB_PROTOCOL_* bits, never 0 */
+    int eval_clips;          /* clips per sequence under the clip protocol */
     int pool_size;
     uint64_t pool_seed;
     int input_points;

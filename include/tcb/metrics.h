@@ -108,7 +108,19 @@ typedef struct tcb_summary {
     tcb_stat geo_auc;            /* over those pairs */
     double geo_pck[TCB_GEO_PCK_STEPS]; /* mean curve over those pairs */
     double geo_unreachable;      /* vertices scored by the Euclidean fallback, summed */
+    /* The clip protocol's tracking error Corr (tcb_corr_frame averaged over
+     * a clip's frames 1-16), over clips; n = 0 when no clip was scored (a
+     * pairs-only run, an older cell). */
+    tcb_stat corr;
 } tcb_summary;
+
+/* The clip protocol's tracking error at one frame t of a clip (DynoSurf's
+ * evaluation/utils.py, eval_correspondences_mesh): the mean over k < n of
+ * the un-squared Euclidean distance |moved[k] - truth[k]| between where the
+ * method carried point k of the clip's frame 0 and its true position on
+ * frame t, summed in double. Corr of a clip is the mean of this over
+ * t = 1 .. 16 (docs/protocol.md, "The clip protocol"). */
+double tcb_corr_frame(const float *moved, const float *truth, int n);
 
 void tcb_summary_init(tcb_summary *s);
 /* cd: the pair's Chamfer distance, or NAN when there is none. */

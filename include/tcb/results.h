@@ -42,7 +42,16 @@
  * came later in the same format: a cell file without them (the four
  * summary keys absent, 11 pair columns) still loads, with geo.n = 0 and
  * geo_auc.n = 0, and reports show "-" for its geodesic columns. A pair's
- * geodesic columns are null when it has none. */
+ * geodesic columns are null when it has none.
+ * The clip protocol (docs/protocol.md, "The clip protocol") came later
+ * too: a cell that scored clips has "summary.corr" ({n, mean, m2} over its
+ * clips) and a top-level
+ *     "clips": {"path", "seed", "clip_frames": 17, "n_clips",
+ *               "columns": ["start", "corr", "err"],
+ *               "rows": [[start, corr, [err_1, …, err_16]], …]}
+ * (err_t: tcb_corr_frame at the clip's frame t; corr their mean); a cell
+ * without clips has neither key (n_clips 0, corr.n 0: "-" in the Corr
+ * column), and a clips-only cell has no pairs (split.n_pairs 0). */
 #ifndef TCB_RESULTS_H
 #define TCB_RESULTS_H
 
@@ -50,6 +59,7 @@
 
 #include "tcb/error.h"
 #include "tcb/metrics.h"
+#include "tcb/split.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -71,6 +81,13 @@ typedef struct tcb_pair_record {
     int geo_unreachable;       /* vertices scored by the Euclidean fallback */
 } tcb_pair_record;
 
+/* One clip of the clip protocol: frames start .. start + TCB_CLIP_FRAMES - 1. */
+typedef struct tcb_clip_record {
+    int start;                          /* the clip's frame 0 */
+    double corr;                        /* mean of err */
+    double err[TCB_CLIP_FRAMES - 1];    /* tcb_corr_frame at the clip's frames 1 .. 16 */
+} tcb_clip_record;
+
 typedef struct tcb_cell_result {
     char dataset[64];
     char sequence[128];
@@ -91,6 +108,11 @@ typedef struct tcb_cell_result {
     int n_pairs;
     tcb_pair_record *pairs;    /* malloc'ed [n_pairs] */
     tcb_summary summary;
+    /* The clip protocol; n_clips = 0: no clips scored (summary.corr.n 0). */
+    char clips_path[4096];
+    unsigned long long clips_seed;
+    int n_clips;
+    tcb_clip_record *clips;    /* malloc'ed [n_clips] */
 } tcb_cell_result;
 
 /* <run>/cells/<dataset>/<sequence>/<method>/seed_<seed>.json */

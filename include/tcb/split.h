@@ -36,6 +36,13 @@ typedef struct tcb_split {
     uint64_t seed;
     int n_pairs;
     int32_t *pairs; /* [n_pairs][2]: i uniform over frames, j uniform over the others of i's block */
+    /* A clip split (tcb_clips_make) when clip_frames > 0, with no pairs:
+     * n_clips clips of clip_frames consecutive frames, clip c the frames
+     * starts[c] .. starts[c] + clip_frames - 1, all in one block; starts
+     * ascending and distinct. 0, 0, NULL in a pair split. */
+    int clip_frames;
+    int n_clips;
+    int32_t *starts;
 } tcb_split;
 
 /* blocks[0..n_blocks) as the sequence's (tcb_blocks_check); NULL, 0 for
@@ -43,7 +50,9 @@ typedef struct tcb_split {
 int tcb_split_make(const char *dataset, const char *sequence, tcb_role role, int n_frames,
                    const tcb_block *blocks, int n_blocks, int n_pairs, uint64_t seed,
                    tcb_split *out, tcb_error *err);
-int tcb_split_save(const char *path, const tcb_split *s, tcb_error *err); /* JSON, atomic */
+/* Either kind of split (a clip split when clip_frames > 0): JSON, atomic;
+ * load takes either file format. */
+int tcb_split_save(const char *path, const tcb_split *s, tcb_error *err);
 int tcb_split_load(const char *path, tcb_split *out, tcb_error *err);
 /* The split as its file's JSON text (the tree tcb_split_save writes,
  * unindented); malloc'ed, NULL when out of memory. */
@@ -56,6 +65,34 @@ int tcb_split_obtain(const char *path, const char *dataset, const char *sequence
                      tcb_role role, int n_frames, const tcb_block *blocks, int n_blocks,
                      int n_pairs, uint64_t seed, tcb_split *out, tcb_error *err);
 void tcb_split_free(tcb_split *s);
+/* The common part of tcb_split_obtain and tcb_clips_obtain: *made is the
+ * split the request makes (freed on failure); the file at path, when it
+ * exists, replaces it if it agrees with it in every field but the pairs
+ * or starts, else the disagreement is the error. */
+int tcb_split_obtain_made(const char *path, tcb_split *made, tcb_error *err);
+
+/* The clip protocol of DynoSurf, PDG and Neu-PiG (docs/protocol.md, "The
+ * clip protocol"): 17 consecutive frames, frame 0 transferred to frames
+ * 1-16. A clip split file <splits_dir>/<dataset>/<sequence>.clips.json,
+ * format "tcbench-clips/1", holds the start frames, drawn once like the
+ * pairs. */
+#define TCB_CLIP_FRAMES 17
+#define TCB_DEFAULT_EVAL_CLIPS 10
+
+/* n_clips distinct start frames s drawn uniformly, without replacement, from
+ * those whose clip [s, s + TCB_CLIP_FRAMES) lies in one block (seeded stream
+ * "clips/<dataset>/<sequence>"), sorted; all of them when there are fewer
+ * (out->n_clips says how many). A sequence with no such clip is an error
+ * (TCB_ERR_INPUT). */
+int tcb_clips_make(const char *dataset, const char *sequence, tcb_role role, int n_frames,
+                   const tcb_block *blocks, int n_blocks, int n_clips, uint64_t seed,
+                   tcb_split *out, tcb_error *err);
+/* tcb_split_obtain for a clip split: load `path` if it agrees with the
+ * request (dataset, sequence, role, n_frames, blocks, clip_frames,
+ * n_clips, seed), else make and save it. */
+int tcb_clips_obtain(const char *path, const char *dataset, const char *sequence, tcb_role role,
+                     int n_frames, const tcb_block *blocks, int n_blocks, int n_clips,
+                     uint64_t seed, tcb_split *out, tcb_error *err);
 
 /* Training-pair sampling (§1.4): given i in its block [lo, hi) of a
  * sequence of n_frames frames (tcb_seq_block_of; [0, n_frames) without

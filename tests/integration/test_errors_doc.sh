@@ -94,6 +94,13 @@ conf python.json '{"methods": [{"name": "mine", "method": "external", "params": 
 row "external: \`python\` for a command that is not a .py script" run python.json
 conf root.json '{"datasets": [{"name": "files", "source": "objdir", "root": "nowhere", "sequences": [{"name": "s", "role": "test"}]}]}'
 row "a dataset root that does not exist" run root.json
+conf protocol.json '{"evaluation": {"pairs": 2, "protocol": "triplets"}}'
+row "an unknown evaluation protocol" run protocol.json
+conf clipcount.json '{"evaluation": {"pairs": 2, "clips": 3}}'
+row "a clip count without the clip protocol" run clipcount.json
+conf short.json '{"evaluation": {"pairs": 2, "protocol": "clips"}}'
+row "the clip protocol on a sequence shorter than 17 frames" run short.json
+rm -rf runs splits
 
 # ---- OBJ frames
 section "OBJ frames (an \`objdir\` dataset)"
@@ -130,6 +137,26 @@ row "fewer pairs than the config's" run split.json
 edit_split 's["n_frames"] = 7'
 row "made for another frame count" run split.json
 cp good_split.json "$split"
+
+# ---- clip split
+section "Clip split files (\`<splits_dir>/<dataset>/<sequence>.clips.json\`, the clip protocol)"
+conf clips.json '{"evaluation": {"pairs": 2, "pool_size": 200, "input_points": 100, "protocol": "clips", "clips": 2},
+                  "datasets": [{"name": "synth", "source": "synthetic", "frames": 20,
+                                "sequences": [{"name": "quadruped_walk", "role": "test"}]}]}'
+rm -rf splits
+run clips.json 2> /dev/null
+clips=splits/synth/quadruped_walk.clips.json
+cp "$clips" good_clips.json
+edit_clips() { /usr/bin/python3 -c 'import json, sys
+s = json.load(open("good_clips.json")); exec(sys.argv[1]); json.dump(s, open(sys.argv[2], "w"))' "$1" "$clips"; }
+edit_clips 's["starts"][-1] = 10'
+row "a clip running past the last frame" run clips.json
+edit_clips 's["starts"] = s["starts"][::-1]'
+row "starts out of order" run clips.json
+edit_clips 's["n_clips"] = 1; s["starts"] = s["starts"][:1]'
+row "fewer clips than the config's" run clips.json
+rm -rf splits runs
+run split.json 2> /dev/null
 
 # ---- cells
 section "Cell files (\`<run>/cells/…/seed_<N>.json\`, read by \`tcbench report\` and \`check\`)"

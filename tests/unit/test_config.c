@@ -119,6 +119,9 @@ static void test_defaults(void **state)
     assert_int_equal(c.pool_size, 10000);
     assert_int_equal(c.pool_seed, 0);
     assert_int_equal(c.input_points, 2500);
+    assert_int_equal(c.protocols, TCB_PROTOCOL_PAIRS);
+    assert_int_equal(c.eval_clips, TCB_DEFAULT_EVAL_CLIPS);
+    assert_null(strstr(c.json_text, "protocol")); /* the default is not spelled out: older run records */
     assert_int_equal(c.datasets[0].seed, 0);
     assert_int_equal(c.datasets[0].frames, 0);
     assert_int_equal(c.datasets[0].norm, TCB_NORM_FIRST_FRAME);
@@ -154,6 +157,35 @@ static void test_normalized_json(void **state)
     assert_true(strstr(n, "\"seeds\"") > o);
     tcb_config_free(&again);
     tcb_config_free(&c);
+}
+
+/* "protocol": one name or a list; the normalized JSON spells out a
+ * non-default one, with its clip count, and parses back to itself. */
+static void test_protocols(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *eval, *json;
+        int bits;
+    } cases[] = {
+        {"\"evaluation\": {\"protocol\": \"pairs\"}", NULL, TCB_PROTOCOL_PAIRS},
+        {"\"evaluation\": {\"protocol\": [\"pairs\"]}", NULL, TCB_PROTOCOL_PAIRS},
+        {"\"evaluation\": {\"protocol\": \"clips\", \"clips\": 4}", "\"protocol\":\t\"clips\",\n\t\t\"clips\":\t4",
+         TCB_PROTOCOL_CLIPS},
+        {"\"evaluation\": {\"protocol\": [\"clips\", \"pairs\"]}", "\"clips\":\t10", TCB_PROTOCOL_PAIRS | TCB_PROTOCOL_CLIPS},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+        tcb_config c, again;
+        tcb_error err = {0};
+        assert_int_equal(tcb_config_parse(config_text(cases[k].eval, NULL, NULL), "t.json", &c, &err), TCB_OK);
+        assert_int_equal(c.protocols, cases[k].bits);
+        if (cases[k].json && !strstr(c.json_text, cases[k].json)) fail_msg("no %s in %s", cases[k].json, c.json_text);
+        if (!cases[k].json) assert_null(strstr(c.json_text, "protocol"));
+        assert_int_equal(tcb_config_parse(c.json_text, "normalized", &again, &err), TCB_OK);
+        assert_string_equal(again.json_text, c.json_text);
+        tcb_config_free(&again);
+        tcb_config_free(&c);
+    }
 }
 
 static void test_load_file(void **state)
@@ -197,6 +229,14 @@ static const bad_case bad_cases[] = {
     {"\"seeds\": []", NULL, NULL, "t.json: seeds: must list at least one seed"},
     {"\"plugins\": [\"\"]", NULL, NULL, "t.json: plugins[0]: expected a non-empty path"},
     {"\"evaluation\": {\"pairs\": 0}", NULL, NULL, "t.json: evaluation.pairs: 0 is out of range"},
+    {"\"evaluation\": {\"protocol\": \"clip\"}", NULL, NULL,
+     "t.json: evaluation.protocol: expected \"pairs\", \"clips\" or a list of them (each once), got \"clip\""},
+    {"\"evaluation\": {\"protocol\": []}", NULL, NULL, "t.json: evaluation.protocol: expected"},
+    {"\"evaluation\": {\"protocol\": [\"clips\", \"clips\"]}", NULL, NULL, "t.json: evaluation.protocol: expected"},
+    {"\"evaluation\": {\"protocol\": [\"pairs\", 2]}", NULL, NULL, "got [\"pairs\",2]"},
+    {"\"evaluation\": {\"protocol\": 1}", NULL, NULL, "t.json: evaluation.protocol: expected"},
+    {"\"evaluation\": {\"clips\": 4}", NULL, NULL, "t.json: evaluation.clips: only with the clip protocol"},
+    {"\"evaluation\": {\"protocol\": \"clips\", \"clips\": 0}", NULL, NULL, "t.json: evaluation.clips: 0 is out of range"},
     {"\"evaluation\": {\"pairs\": 2.5}", NULL, NULL, "t.json: evaluation.pairs: expected an integer"},
     {"\"evaluation\": []", NULL, NULL, "t.json: evaluation: expected an object"},
     {NULL, SYNTH("\"frames\": true, ", SEQ("quadruped_walk", "test")), NULL,
@@ -385,6 +425,7 @@ int main(void)
         cmocka_unit_test(test_full_config),
         cmocka_unit_test(test_defaults),
         cmocka_unit_test(test_normalized_json),
+        cmocka_unit_test(test_protocols),
         cmocka_unit_test(test_dfaust_dataset),
         cmocka_unit_test(test_load_file),
         cmocka_unit_test(test_bad_configs),

@@ -320,7 +320,7 @@ static void test_md_per_seed_table(void **state)
 
 /* ------------------------------------------------------------------ CSV */
 
-#define CSV_MAX_FIELDS 28
+#define CSV_MAX_FIELDS 31
 typedef struct csv_row {
     char field[CSV_MAX_FIELDS][64];
 } csv_row;
@@ -390,15 +390,16 @@ static void test_csv_parses_back(void **state)
 {
     fixture *f = *state;
     int n;
-    csv_row *rows = read_csv(f, "results.csv", 28, &n);
+    csv_row *rows = read_csv(f, "results.csv", 31, &n);
     /* header + 4 sequences × 3 methods + anim's 3 MEAN rows */
     assert_int_equal(n, 1 + 12 + 3);
     assert_string_equal(rows[0].field[7], "sl2_x1e3_mean");
     assert_string_equal(rows[0].field[15], "sl2sq_x1e3_mean");
     assert_string_equal(rows[0].field[17], "geo_x1e3_mean");
     assert_string_equal(rows[0].field[21], "geo_unreachable");
-    assert_string_equal(rows[0].field[22], "sl2_mark");
-    assert_string_equal(rows[0].field[27], "geo_auc_mark");
+    assert_string_equal(rows[0].field[22], "corr_x1e3_mean");
+    assert_string_equal(rows[0].field[24], "sl2_mark");
+    assert_string_equal(rows[0].field[30], "corr_mark");
     expect an = expected(1, 0), nn = expected(1, 1);
     const csv_row *r = find_csv(rows, n, "horse", "AN");
     assert_string_equal(r->field[2], "test");
@@ -408,8 +409,8 @@ static void test_csv_parses_back(void **state)
     assert_csv_values(r, &an, 1);
     assert_csv_values(find_csv(rows, n, "horse", "NN"), &nn, 0);
     /* 2 pairs: nothing significant, every row tied for best (NN has no CD) */
-    assert_string_equal(r->field[22], "tie");
-    assert_string_equal(find_csv(rows, n, "horse", "NN")->field[25], "");
+    assert_string_equal(r->field[24], "tie");
+    assert_string_equal(find_csv(rows, n, "horse", "NN")->field[27], "");
     const int tests[] = {1, 2};
     expect mean = expected_mean(tests, 2, 0);
     r = find_csv(rows, n, "MEAN", "AN");
@@ -483,7 +484,7 @@ static void test_seed_csv_one_row_per_cell(void **state)
 {
     fixture *f = *state;
     int n;
-    csv_row *rows = read_csv(f, "seeds.csv", 13, &n);
+    csv_row *rows = read_csv(f, "seeds.csv", 14, &n);
     assert_string_equal(rows[0].field[4], "seed");
     int n_cells = 0;
     for (int m = 0; m < N_METHODS; m++) n_cells += N_SEQS * METHODS[m].n_seeds;
@@ -532,8 +533,8 @@ static void test_tex_uses_booktabs(void **state)
     assert_contains(tex, "\\midrule");
     assert_contains(tex, "\\bottomrule");
     assert_contains(tex, "m\\_sL2 $\\downarrow$");
-    assert_contains(tex, "m\\_geo $\\downarrow$ & AUC\\_geo $\\uparrow$ \\\\");
-    assert_contains(tex, "\\begin{tabular}{llcccccc}");
+    assert_contains(tex, "m\\_geo $\\downarrow$ & AUC\\_geo $\\uparrow$ & Corr $\\downarrow$ \\\\");
+    assert_contains(tex, "\\begin{tabular}{llccccccc}");
     /* DSR leads, tied for best (2 pairs: nothing can be significant) */
     expect dsr = expected(1, 2);
     char tied[128];
@@ -627,8 +628,10 @@ static void test_old_cells_show_dash(void **state)
     if (strncmp(old, "| OLD (seed 0) | ", 17) || !strstr(old, " ≈ |") || !ends_with(old, " | - | - |"))
         fail_msg("%s", old);
     if (!ends_with(mix, " | - | - |")) fail_msg("%s", mix);
-    /* NEW alone has geodesic numbers, with nothing to compare: not marked */
-    if (strstr(neu, "| - |") || ends_with(neu, "** |") || ends_with(neu, "≈ |")) fail_msg("%s", neu);
+    /* NEW alone has geodesic numbers, with nothing to compare: not marked;
+     * no cell scored clips: "-" under Corr (the last column) */
+    if (!ends_with(neu, " | - |") || strstr(neu, "| - | - |") || strstr(neu, "** | - |") || strstr(neu, "≈ | - |"))
+        fail_msg("%s", neu);
     snprintf(path, sizeof path, "%s/report/pck_geo_anim_horse.png", dir);
     assert_true(tcb_is_file(path));
     free(old), free(neu), free(mix), free(md);

@@ -111,16 +111,41 @@ static void assert_cells_equal(const tcb_cell_result *a, const tcb_cell_result *
     assert_stat_equal(&s->geo_auc, &t->geo_auc);
     assert_memory_equal(s->geo_pck, t->geo_pck, sizeof s->geo_pck);
     assert_true(s->geo_unreachable == t->geo_unreachable);
+    assert_stat_equal(&s->corr, &t->corr);
+    assert_int_equal(a->n_clips, b->n_clips);
+    assert_string_equal(a->clips_path, b->clips_path);
+    assert_true(a->clips_seed == b->clips_seed);
+    if (a->n_clips) assert_memory_equal(a->clips, b->clips, (size_t)a->n_clips * sizeof *a->clips);
 }
 
-static void round_trip(int with_cd)
+/* Two clips of the clip protocol into c (records in clips[2]). */
+static void add_clips(tcb_cell_result *c, tcb_clip_record *clips)
+{
+    snprintf(c->clips_path, sizeof c->clips_path, "splits/%s/%s.clips.json", c->dataset, c->sequence);
+    c->clips_seed = 2021;
+    c->n_clips = 2;
+    c->clips = clips;
+    for (int k = 0; k < 2; k++) {
+        clips[k].start = 3 * k + 1;
+        clips[k].corr = 0;
+        for (int t = 0; t < TCB_CLIP_FRAMES - 1; t++) {
+            clips[k].err[t] = 0.001 * (t + 1) / (k + 3.0);
+            clips[k].corr += clips[k].err[t] / (TCB_CLIP_FRAMES - 1);
+        }
+        tcb_stat_push(&c->summary.corr, clips[k].corr);
+    }
+}
+
+static void round_trip(int with_cd, int with_clips)
 {
     char dir[512], path[4096];
     tu_make_tmpdir(dir, sizeof dir);
     tcb_pair_record pairs[3];
+    tcb_clip_record clips[2];
     tcb_cell_result c, back;
     tcb_error err = {0};
     make_cell(&c, "anim", "horse", "OUR", 3, with_cd, pairs);
+    if (with_clips) add_clips(&c, clips);
     assert_int_equal(tcb_cell_path(path, sizeof path, dir, "anim", "horse", "OUR", 3, &err), 0);
     assert_int_equal(tcb_cell_save(path, &c, &err), TCB_OK);
     assert_int_equal(tcb_cell_load(path, &back, &err), TCB_OK);
@@ -133,13 +158,13 @@ static void round_trip(int with_cd)
 static void test_round_trip_with_cd(void **state)
 {
     (void)state;
-    round_trip(1);
+    round_trip(1, 0);
 }
 
 static void test_round_trip_without_cd(void **state)
 {
     (void)state;
-    round_trip(0);
+    round_trip(0, 0);
 }
 
 static void test_failed_cell_round_trip(void **state)
@@ -253,16 +278,19 @@ static void test_version_kept_and_binding_text(void **state)
 
 typedef void (*json_edit)(cJSON *root);
 
-/* Saves a valid cell, applies `edit` to its JSON, and expects loading to
- * fail with TCB_ERR_INPUT naming the file and `key`. */
-static void expect_rejected(json_edit edit, const char *key)
+/* Saves a valid cell (with two clips when with_clips), applies `edit` to
+ * its JSON, and expects loading to fail with TCB_ERR_INPUT naming the file
+ * and `key`. */
+static void expect_rejected_cell(json_edit edit, const char *key, int with_clips)
 {
     char dir[512], path[4096];
     tu_make_tmpdir(dir, sizeof dir);
     tcb_pair_record pairs[3];
+    tcb_clip_record clips[2];
     tcb_cell_result c, back;
     tcb_error err = {0};
     make_cell(&c, "anim", "cat", "AN", 0, 1, pairs);
+    if (with_clips) add_clips(&c, clips);
     assert_int_equal(tcb_cell_path(path, sizeof path, dir, "anim", "cat", "AN", 0, &err), 0);
     assert_int_equal(tcb_cell_save(path, &c, &err), TCB_OK);
     cJSON *root;
@@ -274,9 +302,12 @@ static void expect_rejected(json_edit edit, const char *key)
     if (!strstr(err.msg, path) || !strstr(err.msg, key))
         fail_msg("message \"%s\" does not name %s and %s", err.msg, path, key);
     assert_null(back.pairs);
+    assert_null(back.clips);
     assert_null(back.params_json);
     tu_remove_tree(dir);
 }
+
+static void expect_rejected(json_edit edit, const char *key) { expect_rejected_cell(edit, key, 0); }
 
 static void drop_status(cJSON *r) { cJSON_DeleteItemFromObject(r, "status"); }
 static void seed_as_string(cJSON *r)
@@ -435,6 +466,44 @@ static void test_loads_cell_without_geodesic(void **state)
     tu_remove_tree(dir);
 }
 
+/* A cell with clips: saved and loaded back the same; damaged clip keys
+ * are refused naming them. */
+static void test_round_trip_with_clips(void **state)
+{
+    (void)state;
+    round_trip(0, 1);
+}
+
+static void drop_corr(cJSON *r) { cJSON_DeleteItemFromObject(cJSON_GetObjectItem(r, "summary"), "corr"); }
+static void clip_frames_16(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(cJSON_GetObjectItem(r, "clips"), "clip_frames", cJSON_CreateNumber(16));
+}
+static void short_clip_errors(cJSON *r)
+{
+    cJSON *row = cJSON_GetArrayItem(cJSON_GetObjectItem(cJSON_GetObjectItem(r, "clips"), "rows"), 1);
+    cJSON_DeleteItemFromArray(cJSON_GetArrayItem(row, 2), 0);
+}
+static void drop_clip_row(cJSON *r)
+{
+    cJSON_DeleteItemFromArray(cJSON_GetObjectItem(cJSON_GetObjectItem(r, "clips"), "rows"), 0);
+}
+static void corr_without_clips(cJSON *r)
+{
+    cJSON *corr = cJSON_Duplicate(cJSON_GetObjectItem(cJSON_GetObjectItem(r, "summary"), "auc"), 1);
+    cJSON_AddItemToObject(cJSON_GetObjectItem(r, "summary"), "corr", corr);
+}
+
+static void test_rejects_bad_clips(void **state)
+{
+    (void)state;
+    expect_rejected_cell(drop_corr, "summary.corr: absent", 1);
+    expect_rejected_cell(clip_frames_16, "clips.clip_frames", 1);
+    expect_rejected_cell(short_clip_errors, "clips.rows[1]", 1);
+    expect_rejected_cell(drop_clip_row, "clips.rows", 1);
+    expect_rejected_cell(corr_without_clips, "summary.corr: over other clips", 0);
+}
+
 static void test_rejects_bad_json(void **state)
 {
     (void)state;
@@ -529,6 +598,8 @@ int main(void)
         cmocka_unit_test(test_rejects_inconsistent_shapes),
         cmocka_unit_test(test_rejects_partial_geodesic),
         cmocka_unit_test(test_loads_cell_without_geodesic),
+        cmocka_unit_test(test_round_trip_with_clips),
+        cmocka_unit_test(test_rejects_bad_clips),
         cmocka_unit_test(test_rejects_bad_json),
         cmocka_unit_test(test_scan_sorts_and_skips_non_cells),
         cmocka_unit_test(test_scan_rejects_misplaced_and_missing),

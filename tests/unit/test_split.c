@@ -433,6 +433,132 @@ static void test_blocks_malformed(void **state)
     }
 }
 
+/* ------------------------------------------------------------ clip splits */
+
+static void clips_ok(const char *seq, int n_frames, const tcb_block *blocks, int n_blocks, int n_clips,
+                     uint64_t seed, tcb_split *s)
+{
+    tcb_error err = {0};
+    if (tcb_clips_make("anim", seq, TCB_ROLE_TEST, n_frames, blocks, n_blocks, n_clips, seed, s, &err))
+        fail_msg("clips: %s", err.msg);
+}
+
+/* The same request draws the same starts; another seed or sequence others;
+ * every clip lies in one block, starts ascending and distinct; every valid
+ * start is drawn about equally often over seeds (without replacement, all
+ * of them when fewer than asked). */
+static void test_clips_make(void **state)
+{
+    (void)state;
+    tcb_split a, b, c, d;
+    clips_ok("cat_walk", 60, NULL, 0, 10, 2021, &a);
+    clips_ok("cat_walk", 60, NULL, 0, 10, 2021, &b);
+    clips_ok("cat_walk", 60, NULL, 0, 10, 2022, &c);
+    clips_ok("horse", 60, NULL, 0, 10, 2021, &d);
+    assert_int_equal(a.n_clips, 10);
+    assert_int_equal(a.clip_frames, TCB_CLIP_FRAMES);
+    assert_int_equal(a.n_pairs, 0);
+    assert_memory_equal(a.starts, b.starts, 10 * sizeof(int32_t));
+    assert_memory_not_equal(a.starts, c.starts, 10 * sizeof(int32_t));
+    assert_memory_not_equal(a.starts, d.starts, 10 * sizeof(int32_t));
+    for (int k = 0; k < 10; k++) {
+        assert_in_range(a.starts[k], 0, 60 - TCB_CLIP_FRAMES);
+        if (k) assert_true(a.starts[k] > a.starts[k - 1]);
+    }
+    tcb_split_free(&a), tcb_split_free(&b), tcb_split_free(&c), tcb_split_free(&d);
+
+    /* 44 valid starts, 4 drawn per seed: each 400 * 4 / 44 ≈ 36 times */
+    int count[44] = {0};
+    for (uint64_t seed = 0; seed < 400; seed++) {
+        clips_ok("cat_walk", 60, NULL, 0, 4, seed, &a);
+        for (int k = 0; k < 4; k++) count[a.starts[k]]++;
+        tcb_split_free(&a);
+    }
+    for (int s = 0; s < 44; s++) assert_in_range(count[s], 15, 60);
+
+    /* Two blocks of 20 and 18 frames: starts 0..3 and 20..21, all six. */
+    const tcb_block blocks[] = {{"a", 0, 20}, {"b", 20, 18}};
+    clips_ok("dfaust_seq", 38, blocks, 2, 10, 1, &a);
+    assert_int_equal(a.n_clips, 6);
+    const int32_t all[] = {0, 1, 2, 3, 20, 21};
+    assert_memory_equal(a.starts, all, sizeof all);
+    tcb_split_free(&a);
+
+    tcb_error err = {0};
+    expect_error(tcb_clips_make("anim", "short", TCB_ROLE_TEST, 16, NULL, 0, 10, 1, &a, &err), &err,
+                 TCB_ERR_INPUT, "clips anim/short", "no 17 consecutive frames");
+    assert_null(a.starts);
+    const tcb_block small[] = {{"a", 0, 16}, {"b", 16, 16}};
+    expect_error(tcb_clips_make("anim", "s", TCB_ROLE_TEST, 32, small, 2, 10, 1, &a, &err), &err,
+                 TCB_ERR_INPUT, "in blocks", NULL);
+    expect_error(tcb_clips_make("anim", "s", TCB_ROLE_TEST, 32, NULL, 0, 0, 1, &a, &err), &err,
+                 TCB_ERR_INPUT, "at least one clip", NULL);
+}
+
+/* Saved and loaded back the same; obtained twice the same file; a request
+ * that disagrees is refused naming the field. */
+static void test_clips_file(void **state)
+{
+    const char *dir = *state;
+    char path[512];
+    snprintf(path, sizeof path, "%s/splits/anim/cat.clips.json", dir);
+    tcb_split a, b;
+    tcb_error err = {0};
+    assert_int_equal(tcb_clips_obtain(path, "anim", "cat", TCB_ROLE_TEST, 35, NULL, 0, 5, 7, &a, &err), TCB_OK);
+    assert_int_equal(tcb_split_load(path, &b, &err), TCB_OK);
+    assert_int_equal(b.clip_frames, TCB_CLIP_FRAMES);
+    assert_int_equal(b.n_clips, 5);
+    assert_null(b.pairs);
+    assert_memory_equal(a.starts, b.starts, 5 * sizeof(int32_t));
+    tcb_split_free(&b);
+    assert_int_equal(tcb_clips_obtain(path, "anim", "cat", TCB_ROLE_TEST, 35, NULL, 0, 5, 7, &b, &err), TCB_OK);
+    assert_memory_equal(a.starts, b.starts, 5 * sizeof(int32_t));
+    tcb_split_free(&a), tcb_split_free(&b);
+    expect_error(tcb_clips_obtain(path, "anim", "cat", TCB_ROLE_TEST, 35, NULL, 0, 6, 7, &a, &err), &err,
+                 TCB_ERR_INPUT, path, "n_clips");
+    expect_error(tcb_clips_obtain(path, "anim", "cat", TCB_ROLE_TEST, 35, NULL, 0, 5, 8, &a, &err), &err,
+                 TCB_ERR_INPUT, path, "seed");
+    /* A pair split where a clip split is asked for, and the reverse. */
+    expect_error(tcb_split_obtain(path, "anim", "cat", TCB_ROLE_TEST, 35, NULL, 0, 0, 7, &a, &err), &err,
+                 TCB_ERR_INPUT, path, "clip_frames");
+}
+
+static void test_clips_malformed(void **state)
+{
+    const char *dir = *state;
+#define HEAD                                                                                 \
+    "{\"format\": \"tcbench-clips/1\", \"dataset\": \"d\", \"sequence\": \"s\", \"role\": \"test\", " \
+    "\"n_frames\": 40, \"seed\": 1, "
+    static const struct {
+        const char *json, *key;
+    } cases[] = {
+        {HEAD "\"clip_frames\": 17, \"n_clips\": 2, \"starts\": [0, 24]}", ".starts[1]: the clip of 17 frames from 24"},
+        {HEAD "\"clip_frames\": 17, \"n_clips\": 2, \"starts\": [5, 5]}", ".starts[1]: 5 does not follow 5"},
+        {HEAD "\"clip_frames\": 17, \"n_clips\": 2, \"starts\": [5, 2]}", ".starts[1]"},
+        {HEAD "\"clip_frames\": 17, \"n_clips\": 2, \"starts\": [5]}", ".starts: 1 starts but n_clips is 2"},
+        {HEAD "\"clip_frames\": 17, \"n_clips\": 1, \"starts\": [-1]}", ".starts[0]"},
+        {HEAD "\"clip_frames\": 17, \"n_clips\": 1, \"starts\": [1.5]}", ".starts[0]"},
+        {HEAD "\"clip_frames\": 17, \"n_clips\": 0, \"starts\": []}", ".n_clips"},
+        {HEAD "\"clip_frames\": 41, \"n_clips\": 1, \"starts\": [0]}", ".clip_frames"},
+        {HEAD "\"n_clips\": 1, \"starts\": [0]}", ".clip_frames"},
+        {HEAD "\"clip_frames\": 17, \"n_clips\": 1, \"starts\": [0], \"pairs\": []}", ".pairs"},
+        {HEAD "\"clip_frames\": 17, \"n_clips\": 1, \"starts\": {}}", ".starts"},
+        {HEAD "\"blocks\": [{\"name\": \"a\", \"start\": 0, \"n_frames\": 20}, {\"name\": \"b\", \"start\": 20, "
+              "\"n_frames\": 20}], \"clip_frames\": 17, \"n_clips\": 1, \"starts\": [10]}",
+         ".starts[0]: the clip of 17 frames from 10 ends past frame 19 (its block's last)"},
+    };
+#undef HEAD
+    for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
+        char path[512];
+        tu_write_text(dir, "bad.clips.json", cases[c].json, path, sizeof path);
+        tcb_split s;
+        tcb_error err = {0};
+        expect_error(tcb_split_load(path, &s, &err), &err, TCB_ERR_INPUT, path, cases[c].key);
+        assert_null(s.starts);
+        assert_null(s.blocks);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -448,6 +574,9 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_blocks_split, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test_setup_teardown(test_blocks_disagreement, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test_setup_teardown(test_blocks_malformed, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test(test_clips_make),
+        cmocka_unit_test_setup_teardown(test_clips_file, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test_setup_teardown(test_clips_malformed, tu_setup_tmpdir, tu_teardown_tmpdir),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
