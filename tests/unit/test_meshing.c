@@ -15,6 +15,7 @@
 #include <time.h>
 
 #include "tcb/geometry.h"
+#include "tcb/locate.h"
 #include "tcb/meshing.h"
 #include "tcb/metrics.h"
 #include "tcb/nn.h"
@@ -204,6 +205,24 @@ static double body_chamfer(const body *b, const tcb_mesh *m)
     return sqrt(cd) / b->diag;
 }
 
+/* Largest distance of the mesh's vertices to the true surface (exact
+ * closest points, tcb/locate.h), as a fraction of the diagonal. */
+static double body_max_distance(const body *b, const tcb_mesh *m)
+{
+    tcb_surface_point *loc = malloc((size_t)m->n_verts * sizeof *loc);
+    float *d2 = tu_falloc((size_t)m->n_verts);
+    tcb_error err = {0};
+    assert_non_null(loc);
+    if (tcb_mesh_locate(b->seq.verts, b->seq.n_verts, b->seq.faces, b->seq.n_faces, m->verts, m->n_verts, loc, d2,
+                        &err))
+        fail_msg("%s", err.msg);
+    double worst = 0;
+    for (int i = 0; i < m->n_verts; i++) worst = fmax(worst, d2[i]);
+    free(d2);
+    free(loc);
+    return sqrt(worst) / b->diag;
+}
+
 /* The keyframe's template as the reference makes it: depth 10, then at most
  * 20 000 triangles. Timed: this is what one keyframe costs. */
 static void test_poisson_body(void **state)
@@ -218,16 +237,20 @@ static void test_poisson_body(void **state)
     double true_vol = signed_volume(&(tcb_mesh){.n_verts = b->seq.n_verts, .n_faces = b->seq.n_faces,
                                                 .verts = b->seq.verts, .faces = b->seq.faces});
     double cd_m = body_chamfer(b, &m), cd_d = body_chamfer(b, &d);
+    double far_m = body_max_distance(b, &m), far_d = body_max_distance(b, &d);
     print_message("body (diag %.3f): Poisson depth %d %.2f s, %d vertices %d faces, sqrt(CD)/diag %.5f, "
-                  "volume %.5f (true %.5f); decimated %.2f s to %d faces, sqrt(CD)/diag %.5f\n",
-                  b->diag, TCB_POISSON_DEPTH, t1 - t0, m.n_verts, m.n_faces, cd_m, signed_volume(&m), true_vol,
-                  t2 - t1, d.n_faces, cd_d);
+                  "farthest vertex %.5f, volume %.5f (true %.5f); decimated %.2f s to %d faces, "
+                  "sqrt(CD)/diag %.5f, farthest vertex %.5f\n",
+                  b->diag, TCB_POISSON_DEPTH, t1 - t0, m.n_verts, m.n_faces, cd_m, far_m, signed_volume(&m),
+                  true_vol, t2 - t1, d.n_faces, cd_d, far_d);
+    assert_true(far_m < 0.01);
+    assert_true(far_d < 0.01);
     assert_true(tu_closed_oriented(m.faces, m.n_faces));
     assert_true(fabs(signed_volume(&m) / true_vol - 1) < 0.05);
-    assert_true(cd_m < 0.005);
+    assert_true(cd_m < 0.006); /* measured 0.0042: sample spacing included */
     assert_true(d.n_faces <= TCB_DECIMATE_FACES);
     assert_true(tu_closed_oriented(d.faces, d.n_faces));
-    assert_true(cd_d < 0.005);
+    assert_true(cd_d < 0.006); /* measured 0.0047 */
     tcb_mesh_free(&d);
     tcb_mesh_free(&m);
 }
