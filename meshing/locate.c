@@ -15,13 +15,6 @@ static void sub3(const double *a, const double *b, double *out)
     for (int d = 0; d < 3; d++) out[d] = a[d] - b[d];
 }
 
-static void set_bary(double *w, double a, double b, double c)
-{
-    w[0] = a;
-    w[1] = b;
-    w[2] = c;
-}
-
 /* Squared distance from p to the point with weights w of triangle t. */
 static double dist2_at(const double *p, const double t[3][3], const double *w)
 {
@@ -30,17 +23,23 @@ static double dist2_at(const double *p, const double t[3][3], const double *w)
     return dot3(e, e);
 }
 
-/* Closest point of segment t[i]–t[j] (weights on i and j only). */
+/* The point at weight 1 − s on vertex i and s on vertex j (s = 0: vertex i). */
+static double edge_at(const double *p, const double t[3][3], int i, int j, double s, double *w)
+{
+    w[0] = w[1] = w[2] = 0;
+    w[i] = 1 - s;
+    w[j] = s;
+    return dist2_at(p, t, w);
+}
+
+/* Closest point of segment t[i]–t[j]. */
 static double closest_on_edge(const double *p, const double t[3][3], int i, int j, double *w)
 {
     double e[3], q[3];
     sub3(t[j], t[i], e);
     sub3(p, t[i], q);
-    double len2 = dot3(e, e), s = len2 > 0 ? fmin(1.0, fmax(0.0, dot3(q, e) / len2)) : 0.0;
-    w[0] = w[1] = w[2] = 0;
-    w[i] = 1 - s;
-    w[j] = s;
-    return dist2_at(p, t, w);
+    double len2 = dot3(e, e);
+    return edge_at(p, t, i, j, len2 > 0 ? fmin(1.0, fmax(0.0, dot3(q, e) / len2)) : 0.0, w);
 }
 
 /* A triangle of zero area: its closest point lies on one of its edges. */
@@ -64,33 +63,24 @@ static double closest_on_triangle(const double *p, const double t[3][3], double 
     sub3(t[2], t[0], ac);
     sub3(p, t[0], ap);
     double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
-    if (d1 <= 0 && d2 <= 0) return set_bary(w, 1, 0, 0), dist2_at(p, t, w);
+    if (d1 <= 0 && d2 <= 0) return edge_at(p, t, 0, 1, 0, w); /* vertex a */
     sub3(p, t[1], bp);
-    double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
-    if (d3 >= 0 && d4 <= d3) return set_bary(w, 0, 1, 0), dist2_at(p, t, w);
-    double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0 && d1 >= 0 && d3 <= 0 && d1 - d3 > 0) {
-        double v = d1 / (d1 - d3);
-        return set_bary(w, 1 - v, v, 0), dist2_at(p, t, w);
-    }
+    double d3 = dot3(ab, bp), d4 = dot3(ac, bp), vc = d1 * d4 - d3 * d2;
+    if (d3 >= 0 && d4 <= d3) return edge_at(p, t, 1, 0, 0, w); /* vertex b */
+    if (vc <= 0 && d1 >= 0 && d3 <= 0 && d1 - d3 > 0) return edge_at(p, t, 0, 1, d1 / (d1 - d3), w);
     sub3(p, t[2], cp);
-    double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
-    if (d6 >= 0 && d5 <= d6) return set_bary(w, 0, 0, 1), dist2_at(p, t, w);
-    double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0 && d2 >= 0 && d6 <= 0 && d2 - d6 > 0) {
-        double s = d2 / (d2 - d6);
-        return set_bary(w, 1 - s, 0, s), dist2_at(p, t, w);
-    }
-    double va = d3 * d6 - d5 * d4;
-    if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0 && (d4 - d3) + (d5 - d6) > 0) {
-        double s = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return set_bary(w, 0, 1 - s, s), dist2_at(p, t, w);
-    }
+    double d5 = dot3(ab, cp), d6 = dot3(ac, cp), vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
+    if (d6 >= 0 && d5 <= d6) return edge_at(p, t, 2, 0, 0, w); /* vertex c */
+    if (vb <= 0 && d2 >= 0 && d6 <= 0 && d2 - d6 > 0) return edge_at(p, t, 0, 2, d2 / (d2 - d6), w);
+    double e4 = d4 - d3, e5 = d5 - d6;
+    if (va <= 0 && e4 >= 0 && e5 >= 0 && e4 + e5 > 0) return edge_at(p, t, 1, 2, e4 / (e4 + e5), w);
     /* The face's interior. On a (nearly) degenerate triangle rounding can
      * land here with weights outside [0, 1]: its edges answer instead. */
     double sum = va + vb + vc;
     if (!(sum > 0) || va < 0 || vb < 0 || vc < 0) return closest_degenerate(p, t, w);
-    set_bary(w, va / sum, vb / sum, vc / sum);
+    w[0] = va / sum;
+    w[1] = vb / sum;
+    w[2] = vc / sum;
     return dist2_at(p, t, w);
 }
 
