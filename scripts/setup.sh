@@ -14,6 +14,7 @@ packages=(
   libcairo2-dev fonts-dejavu-core         # PNG plots with text
   zlib1g-dev                              # .npz results files (deflate, CRC-32)
   libopenblas-openmp-dev                  # dense linear algebra (the OpenMP build: one thread pool)
+  libopen3d-dev                           # meshing/: screened Poisson, quadric decimation, normals (Open3D 0.16)
   libcmocka-dev                           # unit-test framework
   python3 python3-numpy python3-scipy     # tests: JSON comparisons, scipy reference for linear assignment
   python3-pip python3-venv python3-setuptools python3-wheel  # `pip install .` of the Python binding, offline

@@ -88,3 +88,29 @@ void tu_fill_uniform(tcb_rng *r, float *x, size_t n, double lo, double hi)
 {
     for (size_t i = 0; i < n; i++) x[i] = (float)(lo + (hi - lo) * tcb_rng_uniform(r));
 }
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static uint64_t directed(int32_t from, int32_t to) { return (uint64_t)(uint32_t)from << 32 | (uint32_t)to; }
+
+int tu_closed_oriented(const int32_t *faces, int nf)
+{
+    size_t n = 3 * (size_t)nf;
+    uint64_t *e = malloc((n ? n : 1) * sizeof *e);
+    if (!e) abort();
+    for (int f = 0; f < nf; f++)
+        for (int i = 0; i < 3; i++) e[3 * f + i] = directed(faces[3 * f + i], faces[3 * f + (i + 1) % 3]);
+    qsort(e, n, sizeof *e, cmp_u64);
+    int ok = 1;
+    for (size_t i = 1; ok && i < n; i++) ok = e[i] != e[i - 1];
+    for (size_t i = 0; ok && i < n; i++) {
+        uint64_t rev = directed((int32_t)(e[i] & 0xffffffffu), (int32_t)(e[i] >> 32));
+        ok = bsearch(&rev, e, n, sizeof *e, cmp_u64) != NULL;
+    }
+    free(e);
+    return ok;
+}

@@ -4,6 +4,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <stdint.h>
 
 /* cmocka 1.1 has no floating-point assertion: |a − b| ≤ tol, printing both. */
 #define assert_near(a, b, tol)                                                                     \
@@ -42,5 +43,10 @@ double *tu_to_double(const float *x, size_t n);
 /* x[i] = U(lo, hi) from r, in order. */
 struct tcb_rng;
 void tu_fill_uniform(struct tcb_rng *r, float *x, size_t n, double lo, double hi);
+
+/* 1 when nf triangles form closed surfaces, consistently oriented: every
+ * directed edge occurs once and its reverse occurs too (so each undirected
+ * edge has exactly two faces, wound opposite ways); 0 otherwise. */
+int tu_closed_oriented(const int32_t *faces, int nf);
 
 #endif

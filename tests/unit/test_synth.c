@@ -17,6 +17,7 @@
 #include "tcb/distortion.h"
 #include "tcb/geometry.h"
 #include "tcb/synth.h"
+#include "testutil.h"
 
 #define MIN_FACE_AREA 1e-7 /* body length ≈ 1; the smallest measured is ~2e-5 */
 #define ISOMETRY_TOL  0.02 /* total area and mean edge length vs frame 0 (measured ≤ 0.4 %) */
@@ -81,33 +82,6 @@ static void test_lengths(void **state)
 
 /* ---- topology ----------------------------------------------------------- */
 
-static int cmp_u64(const void *a, const void *b)
-{
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return (x > y) - (x < y);
-}
-
-static uint64_t directed(int32_t from, int32_t to) { return (uint64_t)from << 32 | (uint32_t)to; }
-
-/* Closed and consistently oriented ⇔ every directed edge occurs once and
- * its reverse occurs too (so each undirected edge has exactly two faces). */
-static void assert_closed_oriented(const tcb_sequence *s)
-{
-    size_t n = 3 * (size_t)s->n_faces;
-    uint64_t *e = malloc(n * sizeof *e);
-    assert_non_null(e);
-    for (int f = 0; f < s->n_faces; f++)
-        for (int i = 0; i < 3; i++)
-            e[3 * f + i] = directed(s->faces[3 * f + i], s->faces[3 * f + (i + 1) % 3]);
-    qsort(e, n, sizeof *e, cmp_u64);
-    for (size_t i = 1; i < n; i++) assert_true(e[i] != e[i - 1]);
-    for (size_t i = 0; i < n; i++) {
-        uint64_t rev = directed((int32_t)(e[i] & 0xffffffffu), (int32_t)(e[i] >> 32));
-        assert_non_null(bsearch(&rev, e, n, sizeof *e, cmp_u64));
-    }
-    free(e);
-}
-
 static int32_t root(int32_t *parent, int32_t v)
 {
     while (parent[v] != v) v = parent[v] = parent[parent[v]];
@@ -138,7 +112,7 @@ static void test_topology(void **state)
         for (int i = 0; i < 3; i++) assert_in_range(t[i], 0, s.n_verts - 1);
         assert_true(t[0] != t[1] && t[1] != t[2] && t[2] != t[0]);
     }
-    assert_closed_oriented(&s);
+    assert_true(tu_closed_oriented(s.faces, s.n_faces));
     assert_int_equal(count_components(&s), 1);
     /* A closed connected surface with V − E + F = 2 is a sphere (E = 3F/2). */
     assert_int_equal(s.n_verts - 3 * s.n_faces / 2 + s.n_faces, 2);

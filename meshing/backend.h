@@ -1,0 +1,33 @@
+/* The function table between meshing/meshing.c (in libtcbench) and the C++
+ * module meshing/open3d.cpp (libtcbench_meshing.so). meshing.c has checked
+ * every input before a call (counts, finite coordinates, index ranges,
+ * non-zero normals), so the module only converts, calls Open3D and turns
+ * its exceptions into a tcb_error. */
+#ifndef TCB_MESHING_BACKEND_H
+#define TCB_MESHING_BACKEND_H
+
+#include "tcb/error.h"
+#include "tcb/mesh.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TCB_MESHING_MODULE "libtcbench_meshing.so"
+#define TCB_MESHING_ENTRY "tcb_meshing_backend"
+
+typedef struct tcb_meshing_ops {
+    int (*poisson)(const float *pts, const float *normals, int n, int depth, tcb_mesh *out,
+                   tcb_error *err);
+    int (*decimate)(const tcb_mesh *in, int max_faces, tcb_mesh *out, tcb_error *err);
+    /* PCA normals oriented consistently; the sign of the whole set is
+     * meshing.c's to choose. */
+    int (*normals)(const float *pts, int n, int k, float *normals, tcb_error *err);
+} tcb_meshing_ops;
+
+typedef const tcb_meshing_ops *(*tcb_meshing_entry_fn)(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

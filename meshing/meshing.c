@@ -1,0 +1,174 @@
+/* tcb/meshing.h: checks the input, loads the Open3D module beside
+ * libtcbench for the one call, and checks what comes back. */
+#define _GNU_SOURCE /* dladdr */
+#include "tcb/meshing.h"
+
+#include <dlfcn.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "meshing/backend.h"
+#include "tcb/geometry.h"
+
+/* The module lives in the directory of the libtcbench that holds this code
+ * (build tree or install prefix alike), so it is found by that path rather
+ * than by the loader's search path. */
+static void module_path(char *out, size_t size)
+{
+    Dl_info info;
+    const char *self = NULL;
+    if (dladdr((const void *)module_path, &info) && info.dli_fname) self = info.dli_fname;
+    const char *slash = self ? strrchr(self, '/') : NULL;
+    if (slash)
+        snprintf(out, size, "%.*s/%s", (int)(slash - self), self, TCB_MESHING_MODULE);
+    else
+        snprintf(out, size, "%s", TCB_MESHING_MODULE);
+}
+
+typedef struct backend {
+    void *handle;
+    const tcb_meshing_ops *ops;
+} backend;
+
+/* Open3D loads ~100 shared libraries; they are mapped for the call and
+ * released after it (the loader keeps what cannot be unloaded). */
+static int backend_open(backend *b, tcb_error *err)
+{
+    char path[4096];
+    module_path(path, sizeof path);
+    b->handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!b->handle)
+        return tcb_fail(err, TCB_ERR_UNSUPPORTED,
+                        "meshing: cannot load the Open3D module: %s (scripts/setup.sh installs libopen3d-dev; "
+                        "build the target tcbench_meshing)",
+                        dlerror());
+    tcb_meshing_entry_fn entry;
+    *(void **)&entry = dlsym(b->handle, TCB_MESHING_ENTRY); /* POSIX-sanctioned cast of a data pointer */
+    b->ops = entry ? entry() : NULL;
+    if (!b->ops) {
+        dlclose(b->handle);
+        return tcb_fail(err, TCB_ERR_UNSUPPORTED, "meshing: %s has no symbol %s", path, TCB_MESHING_ENTRY);
+    }
+    return TCB_OK;
+}
+
+static void backend_close(backend *b) { dlclose(b->handle); }
+
+static int check_points(const float *pts, int n, int min_n, tcb_error *err)
+{
+    if (!pts || n < min_n) return tcb_fail(err, TCB_ERR_INPUT, "meshing: %d points, need at least %d", n, min_n);
+    if (!tcb_all_finite(pts, (size_t)3 * n))
+        return tcb_fail(err, TCB_ERR_NUMERIC, "meshing: a point coordinate is not finite");
+    float lo[3], hi[3];
+    for (int d = 0; d < 3; d++) lo[d] = hi[d] = pts[d];
+    for (int i = 1; i < n; i++)
+        for (int d = 0; d < 3; d++) {
+            lo[d] = fminf(lo[d], pts[3 * i + d]);
+            hi[d] = fmaxf(hi[d], pts[3 * i + d]);
+        }
+    if (hi[0] == lo[0] && hi[1] == lo[1] && hi[2] == lo[2])
+        return tcb_fail(err, TCB_ERR_INPUT, "meshing: all %d points coincide", n);
+    return TCB_OK;
+}
+
+static int check_normals(const float *normals, int n, tcb_error *err)
+{
+    if (!normals) return tcb_fail(err, TCB_ERR_INPUT, "meshing: no normals given");
+    if (!tcb_all_finite(normals, (size_t)3 * n))
+        return tcb_fail(err, TCB_ERR_NUMERIC, "meshing: a normal is not finite");
+    for (int i = 0; i < n; i++) {
+        const float *u = normals + 3 * i;
+        if (u[0] == 0 && u[1] == 0 && u[2] == 0)
+            return tcb_fail(err, TCB_ERR_INPUT, "meshing: normal %d is zero", i);
+    }
+    return TCB_OK;
+}
+
+static int check_mesh(const tcb_mesh *m, tcb_error *err)
+{
+    if (!m || !m->verts || !m->faces || m->n_verts < 3 || m->n_faces < 1)
+        return tcb_fail(err, TCB_ERR_INPUT, "meshing: the mesh is empty (%d vertices, %d faces)", m ? m->n_verts : 0,
+                        m ? m->n_faces : 0);
+    if (!tcb_all_finite(m->verts, (size_t)3 * m->n_verts))
+        return tcb_fail(err, TCB_ERR_NUMERIC, "meshing: a vertex coordinate is not finite");
+    for (int i = 0; i < 3 * m->n_faces; i++)
+        if (m->faces[i] < 0 || m->faces[i] >= m->n_verts)
+            return tcb_fail(err, TCB_ERR_INPUT, "meshing: face %d names vertex %d of %d", i / 3, m->faces[i],
+                            m->n_verts);
+    return TCB_OK;
+}
+
+/* What a backend returns is checked like any method's output. */
+static int check_result(const tcb_mesh *m, const char *what, tcb_error *err)
+{
+    if (m->n_faces < 1) return tcb_fail(err, TCB_ERR_NUMERIC, "meshing: %s produced no surface", what);
+    if (!tcb_all_finite(m->verts, (size_t)3 * m->n_verts))
+        return tcb_fail(err, TCB_ERR_NUMERIC, "meshing: %s produced a non-finite vertex", what);
+    return TCB_OK;
+}
+
+int tcb_poisson_reconstruct(const float *pts, const float *normals, int n, int depth, tcb_mesh *out,
+                            tcb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    int rc = check_points(pts, n, 4, err);
+    if (!rc) rc = check_normals(normals, n, err);
+    if (rc) return rc;
+    if (depth < TCB_POISSON_DEPTH_MIN || depth > TCB_POISSON_DEPTH_MAX)
+        return tcb_fail(err, TCB_ERR_INPUT, "meshing: Poisson depth %d is outside [%d, %d]", depth,
+                        TCB_POISSON_DEPTH_MIN, TCB_POISSON_DEPTH_MAX);
+    backend b;
+    if ((rc = backend_open(&b, err))) return rc;
+    rc = b.ops->poisson(pts, normals, n, depth, out, err);
+    backend_close(&b);
+    if (!rc) rc = check_result(out, "Poisson reconstruction", err);
+    if (rc) tcb_mesh_free(out);
+    return rc;
+}
+
+int tcb_mesh_decimate(const tcb_mesh *in, int max_faces, tcb_mesh *out, tcb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    int rc = check_mesh(in, err);
+    if (rc) return rc;
+    if (max_faces < 4)
+        return tcb_fail(err, TCB_ERR_INPUT, "meshing: a budget of %d triangles (need at least 4)", max_faces);
+    backend b;
+    if ((rc = backend_open(&b, err))) return rc;
+    rc = b.ops->decimate(in, max_faces, out, err);
+    backend_close(&b);
+    if (!rc) rc = check_result(out, "decimation", err);
+    if (rc) tcb_mesh_free(out);
+    return rc;
+}
+
+/* The sign that makes Σ n_i·(p_i − c) positive, c the points' mean. */
+static void orient_outward(const float *pts, int n, float *normals)
+{
+    double c[3] = {0, 0, 0}, flux = 0;
+    for (int i = 0; i < n; i++)
+        for (int d = 0; d < 3; d++) c[d] += pts[3 * i + d] / (double)n;
+    for (int i = 0; i < n; i++)
+        for (int d = 0; d < 3; d++) flux += normals[3 * i + d] * (pts[3 * i + d] - c[d]);
+    if (flux < 0)
+        for (int i = 0; i < 3 * n; i++) normals[i] = -normals[i];
+}
+
+int tcb_estimate_normals(const float *pts, int n, int k, float *normals, tcb_error *err)
+{
+    int rc = check_points(pts, n, 4, err);
+    if (rc) return rc;
+    if (k < 3) return tcb_fail(err, TCB_ERR_INPUT, "meshing: %d neighbours for a normal (need at least 3)", k);
+    if (!normals) return tcb_fail(err, TCB_ERR_INPUT, "meshing: no array for the normals");
+    backend b;
+    if ((rc = backend_open(&b, err))) return rc;
+    rc = b.ops->normals(pts, n, k < n ? k : n, normals, err);
+    backend_close(&b);
+    if (rc) return rc;
+    if (!tcb_all_finite(normals, (size_t)3 * n))
+        return tcb_fail(err, TCB_ERR_NUMERIC, "meshing: normal estimation produced a non-finite normal");
+    orient_outward(pts, n, normals);
+    return TCB_OK;
+}

@@ -1,0 +1,143 @@
+// The meshing backend: tcbench's C calls turned into Open3D 0.16 calls, and
+// Open3D's exceptions turned back into a tcb_error (none may cross into C).
+// Built as the module libtcbench_meshing.so, which meshing/meshing.c loads
+// when a meshing function is first called; inputs arrive checked.
+#include <open3d/geometry/KDTreeSearchParam.h>
+#include <open3d/geometry/PointCloud.h>
+#include <open3d/geometry/TriangleMesh.h>
+#include <open3d/utility/Logging.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <limits>
+#include <memory>
+#include <new>
+
+#include "meshing/backend.h"
+
+namespace {
+
+using open3d::geometry::PointCloud;
+using open3d::geometry::TriangleMesh;
+
+// Open3D reports through exceptions and prints warnings; a library of
+// tcbench never prints, so only errors (thrown, then caught below) remain.
+void quiet() { open3d::utility::SetVerbosityLevel(open3d::utility::VerbosityLevel::Error); }
+
+PointCloud make_cloud(const float *pts, const float *normals, int n)
+{
+    PointCloud pc;
+    pc.points_.resize(n);
+    if (normals) pc.normals_.resize(n);
+    for (int i = 0; i < n; i++) {
+        const float *p = pts + 3 * i;
+        pc.points_[i] = Eigen::Vector3d(p[0], p[1], p[2]);
+        if (normals) pc.normals_[i] = Eigen::Vector3d(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
+    }
+    return pc;
+}
+
+// Copies Open3D's mesh into a malloc'ed tcb_mesh (the caller frees it with
+// tcb_mesh_free).
+int to_tcb_mesh(const TriangleMesh &m, tcb_mesh *out, tcb_error *err)
+{
+    const size_t nv = m.vertices_.size(), nf = m.triangles_.size();
+    if (nv > (size_t)std::numeric_limits<int>::max() / 3 || nf > (size_t)std::numeric_limits<int>::max() / 3)
+        return tcb_fail(err, TCB_ERR_INTERNAL, "meshing: the mesh has too many elements (%zu vertices, %zu faces)", nv,
+                        nf);
+    float *v = static_cast<float *>(std::malloc(3 * (nv ? nv : 1) * sizeof(float)));
+    int32_t *f = static_cast<int32_t *>(std::malloc(3 * (nf ? nf : 1) * sizeof(int32_t)));
+    if (!v || !f) {
+        std::free(v);
+        std::free(f);
+        return tcb_fail(err, TCB_ERR_NOMEM, "meshing: out of memory for a mesh of %zu vertices", nv);
+    }
+    for (size_t i = 0; i < nv; i++)
+        for (int d = 0; d < 3; d++) v[3 * i + d] = (float)m.vertices_[i][d];
+    for (size_t i = 0; i < nf; i++)
+        for (int d = 0; d < 3; d++) f[3 * i + d] = m.triangles_[i][d];
+    out->verts = v;
+    out->faces = f;
+    out->n_verts = (int)nv;
+    out->n_faces = (int)nf;
+    return TCB_OK;
+}
+
+// Runs one Open3D call; what it throws becomes a one-line tcb_error.
+template <class F> int guarded(const char *what, tcb_error *err, F &&call)
+{
+    try {
+        quiet();
+        return call();
+    } catch (const std::bad_alloc &) {
+        return tcb_fail(err, TCB_ERR_NOMEM, "meshing: %s: out of memory", what);
+    } catch (const std::exception &e) {
+        // Qhull's errors run to twenty lines: the first says what failed.
+        const char *msg = e.what();
+        return tcb_fail(err, TCB_ERR_NUMERIC, "meshing: %s failed in Open3D: %.*s", what,
+                        (int)std::min<size_t>(std::strcspn(msg, "\n"), 200), msg);
+    } catch (...) {
+        return tcb_fail(err, TCB_ERR_INTERNAL, "meshing: %s failed in Open3D (unknown exception)", what);
+    }
+}
+
+// Open3D's defaults but for depth and threads: width 0 (depth decides),
+// scale 1.1 (the cube around the points; MeshLab's default too), no linear
+// fit (MeshLab's default too), one thread (the reference's threads=1; the
+// vertex order depends on the thread count).
+int poisson(const float *pts, const float *normals, int n, int depth, tcb_mesh *out, tcb_error *err)
+{
+    return guarded("screened Poisson", err, [&] {
+        PointCloud pc = make_cloud(pts, normals, n);
+        auto result = TriangleMesh::CreateFromPointCloudPoisson(pc, (size_t)depth, 0.0f, 1.1f, false, 1);
+        return to_tcb_mesh(*std::get<0>(result), out, err);
+    });
+}
+
+// Open3D's quadric decimation with the defaults the reference uses
+// (simplify_quadric_decimation(target)): no error bound, boundary weight 1.
+int decimate(const tcb_mesh *in, int max_faces, tcb_mesh *out, tcb_error *err)
+{
+    return guarded("quadric decimation", err, [&] {
+        TriangleMesh m;
+        m.vertices_.resize(in->n_verts);
+        m.triangles_.resize(in->n_faces);
+        for (int i = 0; i < in->n_verts; i++) {
+            const float *p = in->verts + 3 * i;
+            m.vertices_[i] = Eigen::Vector3d(p[0], p[1], p[2]);
+        }
+        for (int i = 0; i < in->n_faces; i++) {
+            const int32_t *t = in->faces + 3 * i;
+            m.triangles_[i] = Eigen::Vector3i(t[0], t[1], t[2]);
+        }
+        auto simple = m.SimplifyQuadricDecimation(max_faces, std::numeric_limits<double>::infinity(), 1.0);
+        simple->RemoveUnreferencedVertices();
+        return to_tcb_mesh(*simple, out, err);
+    });
+}
+
+// PCA normals (Eigen's symmetric eigen-solver, not Open3D's closed-form
+// "fast" one, which loses accuracy on nearly planar neighbourhoods), then
+// Hoppe's propagation along the minimum spanning tree of the Delaunay and
+// k-NN graph.
+int normals(const float *pts, int n, int k, float *out, tcb_error *err)
+{
+    return guarded("normal estimation", err, [&] {
+        PointCloud pc = make_cloud(pts, nullptr, n);
+        pc.EstimateNormals(open3d::geometry::KDTreeSearchParamKNN(k), false);
+        pc.OrientNormalsConsistentTangentPlane((size_t)k);
+        for (int i = 0; i < n; i++) {
+            Eigen::Vector3d u = pc.normals_[i].normalized();
+            for (int d = 0; d < 3; d++) out[3 * i + d] = (float)u[d];
+        }
+        return (int)TCB_OK;
+    });
+}
+
+const tcb_meshing_ops ops = {poisson, decimate, normals};
+
+} // namespace
+
+extern "C" __attribute__((visibility("default"))) const tcb_meshing_ops *tcb_meshing_backend(void) { return &ops; }

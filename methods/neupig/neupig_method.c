@@ -1,0 +1,474 @@
+/* neupig: Neural Preconditioned Grids (Neu-PiG, CVPR 2026): one template,
+ * the keyframe's screened Poisson surface decimated to a triangle budget
+ * (tcb/meshing.h), moved into every frame by a per-vertex rigid motion
+ * that an MLP reads from preconditioned feature grids and the frame's time
+ * (methods/neupig/model.h), optimised per sequence on the frames' point
+ * clouds (methods/neupig/train.h). docs/protocol.md, "Neu-PiG", lists the
+ * reference files followed and every difference.
+ *
+ * Params (presets overridable key by key; default cpu):
+ *   preset   paper (1 000 epochs, 5 000 points a frame, 20 000 triangles,
+ *            depth 10, the reference's network), fast (the paper's
+ *            250-epoch variant), cpu (provisional sizing for 2 cores, to
+ *            be chosen on the cat: issue 28), tiny (tests)
+ *   normals  estimated (default: PCA, oriented; tcbench's methods see
+ *            points only) | gt (the reference's setting: the ground-truth
+ *            face normal at each keyframe point)
+ *   epochs, points, template_faces, poisson_depth, levels, features,
+ *   hidden, recon_points, checkpoint_every, divergence
+ *
+ * Read-out (transfer i → j): each source point, in the method's cube, is
+ * located on the template deformed to frame i (closest surface point,
+ * barycentric coordinates: tcb/locate.h) and carried to the same point of
+ * the template deformed to frame j; the harness projects it onto j's GT
+ * vertices. reconstruct samples the deformed template's surface.
+ *
+ * Checkpoints: the whole optimisation state in <work_dir>/train.ckpt
+ * (continued bit-identically); the model file holds the parameters and the
+ * fit's seed, and load rebuilds the template from the sequence with that
+ * seed (the clouds, keyframe, normals and Poisson surface are
+ * deterministic) rather than storing it. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "methods/builtin.h"
+#include "methods/neupig/prepare.h"
+#include "methods/neupig/train.h"
+#include "methods/params.h"
+#include "neural/train_loop.h"
+#include "neural/weights.h"
+#include "tcb/geodesic.h"
+#include "tcb/geometry.h"
+#include "tcb/json.h"
+#include "tcb/locate.h"
+#include "tcb/meshing.h"
+
+#define CKPT_NAME "train.ckpt"
+#define MAGIC "TCBNPIG1"
+
+typedef struct neupig_preset {
+    long long epochs;
+    int points, template_faces, poisson_depth, levels, features, hidden;
+} neupig_preset;
+
+static const neupig_preset presets[] = {
+    {1000, 5000, 20000, 10, 8, 30, 512}, /* paper */
+    {250, 5000, 20000, 10, 8, 30, 512},  /* fast */
+    {250, 2500, 5000, 8, 6, 16, 128},    /* cpu (provisional) */
+    {30, 300, 400, 6, 3, 8, 16},         /* tiny */
+};
+static const char *const preset_names[] = {"paper", "fast", "cpu", "tiny", NULL};
+static const char *const normals_names[] = {"estimated", "gt", NULL};
+
+typedef struct neupig_method {
+    tcb_neupig_arch arch;
+    tcb_neupig_schedule sched;
+    int points, template_faces, poisson_depth, gt_normals, recon_points;
+    long long checkpoint_every;
+    uint64_t seed;
+    /* The fitted model (after fit or load). */
+    float *params;                 /* [n_params] */
+    tcb_neupig_frame_map map;      /* sequence coordinates → the grids' cube */
+    tcb_mesh template_mesh;        /* in the cube */
+    float *deformed;               /* [T][nv][3] the template in every frame, in the cube */
+    int n_frames;
+} neupig_method;
+
+static int parse(const char *params_json, neupig_method *m, tcb_error *err)
+{
+    static const char *const keys[] = {"preset", "normals", "epochs", "points", "template_faces", "poisson_depth",
+                                       "levels", "features", "hidden", "recon_points", "checkpoint_every",
+                                       "divergence", NULL};
+    const char *where = "neupig.params";
+    cJSON *j;
+    int rc = tcb_params_parse(params_json, where, keys, &j, err);
+    if (rc) return rc;
+    int pi = 2, ni = 0;
+    long long epochs, points, faces, depth, levels, features, hidden, recon;
+    rc = tcb_json_enum(j, "preset", where, 0, 2, preset_names, &pi, err);
+    if (!rc) rc = tcb_json_enum(j, "normals", where, 0, 0, normals_names, &ni, err);
+    const neupig_preset *p = &presets[pi];
+    if (!rc) rc = tcb_json_int(j, "epochs", where, 0, p->epochs, 1, 100000000, &epochs, err);
+    if (!rc) rc = tcb_json_int(j, "points", where, 0, p->points, 4, 10000000, &points, err);
+    if (!rc) rc = tcb_json_int(j, "template_faces", where, 0, p->template_faces, 4, 10000000, &faces, err);
+    if (!rc) rc = tcb_json_int(j, "poisson_depth", where, 0, p->poisson_depth, TCB_POISSON_DEPTH_MIN,
+                                TCB_POISSON_DEPTH_MAX, &depth, err);
+    if (!rc) rc = tcb_json_int(j, "levels", where, 0, p->levels, 1, TCB_NEUPIG_MAX_LEVELS, &levels, err);
+    if (!rc) rc = tcb_json_int(j, "features", where, 0, p->features, 1, 4096, &features, err);
+    if (!rc) rc = tcb_json_int(j, "hidden", where, 0, p->hidden, 1, 65536, &hidden, err);
+    if (!rc) rc = tcb_json_int(j, "recon_points", where, 0, 2500, 1, 10000000, &recon, err);
+    if (!rc) rc = tcb_json_int(j, "checkpoint_every", where, 0, 50, 0, 100000000, &m->checkpoint_every, err);
+    if (!rc) rc = tcb_json_num(j, "divergence", where, 0, 1e4, 0, 1e300, &m->sched.divergence, err);
+    cJSON_Delete(j);
+    if (rc) return rc;
+    m->arch = tcb_neupig_arch_reference();
+    m->arch.levels = (int)levels, m->arch.features = (int)features, m->arch.hidden = (int)hidden;
+    m->sched.epochs = epochs, m->sched.lr_grid = 0.005, m->sched.lr_growth = 2.5, m->sched.lr_mlp = 1e-3;
+    m->points = (int)points, m->template_faces = (int)faces, m->poisson_depth = (int)depth;
+    m->gt_normals = ni == 1, m->recon_points = (int)recon;
+    return TCB_OK;
+}
+
+static void release_model(neupig_method *m)
+{
+    free(m->params), free(m->deformed);
+    tcb_mesh_free(&m->template_mesh);
+    m->params = NULL, m->deformed = NULL;
+}
+
+static int create(const char *params_json, void **self, tcb_error *err)
+{
+    *self = NULL;
+    neupig_method *m = calloc(1, sizeof *m);
+    if (!m) return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    int rc = parse(params_json, m, err);
+    if (rc) {
+        free(m);
+        return rc;
+    }
+    *self = m;
+    return TCB_OK;
+}
+
+static void destroy(void *self)
+{
+    neupig_method *m = self;
+    if (!m) return;
+    release_model(m);
+    free(m);
+}
+
+/* ---- the inputs of an optimisation, rebuilt identically by fit and load ---- */
+
+typedef struct inputs {
+    int T;
+    float **clouds;      /* [T] → [n[t]][3] in the cube */
+    int *n;
+    tcb_nn **index;      /* [T] */
+    float *vnormals;     /* [nv][3] the template's vertex normals */
+    int32_t *edges;      /* [ne][2] */
+    float *edge_len;     /* [ne] */
+    int ne, key;
+    tcb_neupig_problem problem;
+} inputs;
+
+static void inputs_free(inputs *in)
+{
+    for (int t = 0; in->clouds && t < in->T; t++) free(in->clouds[t]), tcb_nn_free(in->index[t]);
+    free(in->clouds), free(in->n), free(in->index), free(in->vnormals), free(in->edges), free(in->edge_len);
+    memset(in, 0, sizeof *in);
+}
+
+/* Every frame's cloud of m->points from the pools, stream (seed,
+ * "neupig/points"), then the map into the cube and the mapped clouds. */
+static int draw_clouds(neupig_method *m, const tcb_sequence *seq, uint64_t seed, inputs *in, tcb_error *err)
+{
+    in->T = seq->n_frames;
+    in->clouds = calloc((size_t)in->T, sizeof *in->clouds);
+    in->n = calloc((size_t)in->T, sizeof *in->n);
+    in->index = calloc((size_t)in->T, sizeof *in->index);
+    if (!in->clouds || !in->n || !in->index) return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    tcb_rng rng;
+    tcb_rng_seed_stream(&rng, seed, "neupig/points");
+    int rc = TCB_OK;
+    for (int t = 0; !rc && t < in->T; t++) {
+        in->n[t] = m->points;
+        if (!(in->clouds[t] = malloc((size_t)m->points * 3 * sizeof(float))))
+            return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+        rc = tcb_sequence_draw_points(seq, t, m->points, seq->draw_with_replacement, &rng, in->clouds[t], err);
+    }
+    if (!rc) rc = tcb_neupig_frame_map_of((const float *const *)in->clouds, in->n, in->T, &m->map, err);
+    for (int t = 0; !rc && t < in->T; t++) {
+        tcb_neupig_map_points(&m->map, in->clouds[t], in->n[t], in->clouds[t]);
+        rc = tcb_nn_build(in->clouds[t], in->n[t], &in->index[t], err);
+    }
+    return rc;
+}
+
+/* Normals of the keyframe's cloud: estimated, or the GT face under each
+ * point (the cloud comes from the GT surface; the map is a similarity, so
+ * face normals are the same in the cube). */
+static int keyframe_normals(const neupig_method *m, const tcb_sequence *seq, const inputs *in, float *normals,
+                            tcb_error *err)
+{
+    const float *cloud = in->clouds[in->key];
+    int n = in->n[in->key];
+    if (!m->gt_normals) return tcb_estimate_normals(cloud, n, TCB_NORMALS_K, normals, err);
+    float *gt = malloc((size_t)seq->n_verts * 3 * sizeof *gt);
+    tcb_surface_point *loc = malloc((size_t)n * sizeof *loc);
+    int rc = gt && loc ? TCB_OK : tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    if (!rc) {
+        tcb_neupig_map_points(&m->map, tcb_seq_frame(seq, in->key), seq->n_verts, gt);
+        rc = tcb_mesh_locate(gt, seq->n_verts, seq->faces, seq->n_faces, cloud, n, loc, NULL, err);
+    }
+    for (int i = 0; !rc && i < n; i++) {
+        const int32_t *f = seq->faces + 3 * (size_t)loc[i].face;
+        const float *a = gt + 3 * (size_t)f[0], *b = gt + 3 * (size_t)f[1], *c = gt + 3 * (size_t)f[2];
+        double u[3], v[3], nn[3], len;
+        for (int k = 0; k < 3; k++) u[k] = (double)b[k] - a[k], v[k] = (double)c[k] - a[k];
+        nn[0] = u[1] * v[2] - u[2] * v[1], nn[1] = u[2] * v[0] - u[0] * v[2], nn[2] = u[0] * v[1] - u[1] * v[0];
+        len = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+        for (int k = 0; k < 3; k++) normals[3 * (size_t)i + k] = (float)(len > 0 ? nn[k] / len : 0.0);
+    }
+    free(gt), free(loc);
+    return rc;
+}
+
+/* The keyframe's screened Poisson surface, decimated to the budget. */
+static int build_template(neupig_method *m, const tcb_sequence *seq, const inputs *in, tcb_error *err)
+{
+    int n = in->n[in->key];
+    float *normals = malloc((size_t)n * 3 * sizeof *normals);
+    tcb_mesh surface = {0, 0, NULL, NULL};
+    int rc = normals ? keyframe_normals(m, seq, in, normals, err) : tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    if (!rc) rc = tcb_poisson_reconstruct(in->clouds[in->key], normals, n, m->poisson_depth, &surface, err);
+    if (!rc) rc = tcb_mesh_decimate(&surface, m->template_faces, &m->template_mesh, err);
+    tcb_mesh_free(&surface);
+    free(normals);
+    return rc;
+}
+
+/* The template's undirected edges (each once, a < b) and their lengths. */
+static int template_edges(const tcb_mesh *t, inputs *in, tcb_error *err)
+{
+    tcb_edge_graph g;
+    int rc = tcb_edge_graph_build(t->faces, t->n_faces, t->n_verts, &g, err);
+    if (rc) return rc;
+    in->edges = malloc(2 * (size_t)g.n_edges * sizeof *in->edges);
+    in->edge_len = malloc((size_t)g.n_edges * sizeof *in->edge_len);
+    if (!in->edges || !in->edge_len) rc = tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    for (int a = 0; !rc && a < g.n_verts; a++)
+        for (int e = g.offsets[a]; e < g.offsets[a + 1]; e++) {
+            int b = g.adj[e];
+            if (b < a) continue;
+            const float *p = t->verts + 3 * (size_t)a, *q = t->verts + 3 * (size_t)b;
+            double d = 0.0;
+            for (int k = 0; k < 3; k++) d += ((double)p[k] - q[k]) * ((double)p[k] - q[k]);
+            in->edges[2 * in->ne] = a, in->edges[2 * in->ne + 1] = b;
+            in->edge_len[in->ne++] = (float)sqrt(d);
+        }
+    tcb_edge_graph_free(&g);
+    return rc;
+}
+
+static int prepare(neupig_method *m, const tcb_sequence *seq, uint64_t seed, inputs *in, tcb_error *err)
+{
+    memset(in, 0, sizeof *in);
+    tcb_mesh_free(&m->template_mesh);
+    int rc = draw_clouds(m, seq, seed, in, err);
+    if (!rc)
+        rc = tcb_neupig_keyframe((const float *const *)in->clouds, in->n, in->T, TCB_NEUPIG_KEYFRAME_RES, &in->key, err);
+    if (!rc) rc = build_template(m, seq, in, err);
+    const tcb_mesh *t = &m->template_mesh;
+    if (!rc && !(in->vnormals = malloc((size_t)t->n_verts * 3 * sizeof *in->vnormals)))
+        rc = tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    if (!rc) {
+        tcb_vertex_normals(t->verts, t->n_verts, t->faces, t->n_faces, in->vnormals);
+        rc = template_edges(t, in, err);
+    }
+    if (!rc)
+        in->problem = (tcb_neupig_problem){t->n_verts, t->verts, in->vnormals, in->ne, in->edges, in->edge_len,
+                                           in->T, (const float *const *)in->clouds, in->n,
+                                           (const tcb_nn *const *)in->index, in->key};
+    if (rc) tcb_error_prefix(err, "neupig: ");
+    return rc;
+}
+
+/* The template deformed into every frame, from m->params. */
+static int deform_all(neupig_method *m, const inputs *in, tcb_error *err)
+{
+    tcb_neupig_model model;
+    free(m->deformed);
+    m->n_frames = in->T;
+    m->deformed = malloc((size_t)in->T * (size_t)m->template_mesh.n_verts * 3 * sizeof(float));
+    if (!m->deformed) return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    int rc = tcb_neupig_model_init(&model, &m->arch, err);
+    if (!rc) rc = tcb_neupig_deform(&model, m->params, &in->problem, m->deformed, err);
+    tcb_neupig_model_free(&model);
+    return rc;
+}
+
+/* ---- fit ---- */
+
+static int fit_step(void *t, double *loss, tcb_error *err) { return tcb_neupig_train_step(t, loss, err); }
+static long long fit_done(const void *t) { return ((const tcb_neupig_trainer *)t)->it; }
+
+typedef struct fit_state {
+    tcb_neupig_trainer trainer;
+    uint64_t seed;
+} fit_state;
+
+static int fit_save(const void *f, double seconds, const char *path, tcb_error *err)
+{
+    const fit_state *s = f;
+    return tcb_neupig_train_save(&s->trainer, s->seed, seconds, path, err);
+}
+
+static int fit_load(void *f, const char *path, double *seconds, tcb_error *err)
+{
+    fit_state *s = f;
+    return tcb_neupig_train_load(&s->trainer, s->seed, path, seconds, err);
+}
+
+static int fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_error *err)
+{
+    neupig_method *m = self;
+    release_model(m);
+    m->seed = ctx->seed;
+    inputs in;
+    fit_state s = {.seed = ctx->seed};
+    int rc = prepare(m, seq, ctx->seed, &in, err);
+    if (!rc) rc = tcb_neupig_trainer_init(&s.trainer, &m->arch, &m->sched, &in.problem, ctx->seed, err);
+    if (!rc) {
+        tcb_train_loop loop = {.name = "neupig", .iterations = m->sched.epochs, .checkpoint_every = m->checkpoint_every,
+                               .ckpt_name = CKPT_NAME, .trainer = &s, .step = fit_step, .done = fit_done,
+                               .save = fit_save, .load = fit_load};
+        rc = tcb_train_loop_run(&loop, ctx, err);
+    }
+    if (!rc && !(m->params = malloc(s.trainer.model.n_params * sizeof *m->params)))
+        rc = tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    if (!rc) {
+        memcpy(m->params, s.trainer.params, s.trainer.model.n_params * sizeof *m->params);
+        rc = deform_all(m, &in, err);
+    }
+    tcb_neupig_trainer_free(&s.trainer);
+    inputs_free(&in);
+    return rc;
+}
+
+/* ---- read-out ---- */
+
+static int check_frames(const neupig_method *m, const tcb_sequence *seq, int i, int j, tcb_error *err)
+{
+    if (!m->deformed) return tcb_fail(err, TCB_ERR_INTERNAL, "neupig: evaluation before fit or load");
+    if (i < 0 || j < 0 || i >= m->n_frames || j >= m->n_frames || seq->n_frames != m->n_frames)
+        return tcb_fail(err, TCB_ERR_INPUT, "neupig: pair %d->%d outside frames 0..%d of the fitted sequence", i, j,
+                        m->n_frames - 1);
+    return TCB_OK;
+}
+
+static const float *frame_of(const neupig_method *m, int f)
+{
+    return m->deformed + (size_t)f * (size_t)m->template_mesh.n_verts * 3;
+}
+
+/* Points of the cube back in the sequence's coordinates, in place. */
+static void unmap(const neupig_method *m, float *pts, int n)
+{
+    for (size_t i = 0; i < 3 * (size_t)n; i++) pts[i] = (float)(pts[i] / m->map.scale + m->map.centre[i % 3]);
+}
+
+static int transfer(void *self, const tcb_sequence *seq, int i, int j, const float *src, int n, float *out,
+                    tcb_rng *rng, tcb_error *err)
+{
+    (void)rng;
+    neupig_method *m = self;
+    int rc = check_frames(m, seq, i, j, err);
+    if (rc) return rc;
+    const tcb_mesh *t = &m->template_mesh;
+    tcb_surface_point *loc = malloc((size_t)n * sizeof *loc);
+    if (!loc) return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    tcb_neupig_map_points(&m->map, src, n, out);
+    rc = tcb_mesh_locate(frame_of(m, i), t->n_verts, t->faces, t->n_faces, out, n, loc, NULL, err);
+    if (!rc) {
+        tcb_surface_points(frame_of(m, j), t->faces, loc, n, out);
+        unmap(m, out, n);
+    }
+    free(loc);
+    return rc;
+}
+
+static int reconstruct(void *self, const tcb_sequence *seq, int i, int j, int frame, tcb_rng *rng, float **pts,
+                       int *n, tcb_error *err)
+{
+    neupig_method *m = self;
+    *pts = NULL;
+    int rc = check_frames(m, seq, i, j, err);
+    if (rc) return rc;
+    const tcb_mesh *t = &m->template_mesh;
+    if (!(*pts = malloc((size_t)m->recon_points * 3 * sizeof **pts)))
+        return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    rc = tcb_sample_surface(frame_of(m, frame), t->faces, t->n_faces, m->recon_points, rng, *pts, err);
+    if (rc) {
+        free(*pts), *pts = NULL;
+        return rc;
+    }
+    unmap(m, *pts, m->recon_points);
+    *n = m->recon_points;
+    return TCB_OK;
+}
+
+/* ---- the model file: the parameters under a manifest of the architecture ---- */
+
+static cJSON *manifest(const neupig_method *m, size_t n_params)
+{
+    const tcb_neupig_arch *a = &m->arch;
+    cJSON *j = cJSON_CreateObject();
+    cJSON_AddStringToObject(j, "method", "neupig");
+    const int sizes[] = {a->levels, a->base_res, a->res_step, a->features, a->normal_res, a->normal_features,
+                         a->time_freqs, a->hidden, m->points, m->template_faces, m->poisson_depth, m->gt_normals};
+    const char *const names[] = {"levels", "base_res", "res_step", "features", "normal_res", "normal_features",
+                                 "time_freqs", "hidden", "points", "template_faces", "poisson_depth", "gt_normals"};
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) cJSON_AddNumberToObject(j, names[k], sizes[k]);
+    cJSON_AddNumberToObject(j, "parameters", (double)n_params);
+    return j;
+}
+
+static size_t n_params_of(const neupig_method *m, tcb_error *err)
+{
+    tcb_neupig_model model;
+    if (tcb_neupig_model_init(&model, &m->arch, err)) return 0;
+    size_t n = model.n_params;
+    tcb_neupig_model_free(&model);
+    return n;
+}
+
+static int save(void *self, const char *path, tcb_error *err)
+{
+    neupig_method *m = self;
+    if (!m->params) return tcb_fail(err, TCB_ERR_INTERNAL, "%s: neupig saved before fit", path);
+    size_t n = n_params_of(m, err);
+    if (!n) return err->code;
+    cJSON *j = manifest(m, n);
+    tcb_weight_parts w = {1, {m->params, NULL}, {n, 0}};
+    int rc = tcb_model_file_write(path, MAGIC, m->seed, j, &w, err);
+    cJSON_Delete(j);
+    return rc;
+}
+
+static int load(void *self, const tcb_sequence *seq, const char *path, tcb_error *err)
+{
+    neupig_method *m = self;
+    release_model(m);
+    size_t n = n_params_of(m, err);
+    if (!n) return err->code;
+    if (!(m->params = malloc(n * sizeof *m->params))) return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    cJSON *want = manifest(m, n);
+    tcb_weight_parts w = {1, {m->params, NULL}, {n, 0}};
+    uint64_t seed = 0;
+    int rc = tcb_model_file_read(path, MAGIC, want, &seed, &w, err);
+    cJSON_Delete(want);
+    inputs in;
+    memset(&in, 0, sizeof in);
+    if (!rc) rc = prepare(m, seq, seed, &in, err);
+    if (!rc) rc = deform_all(m, &in, err);
+    inputs_free(&in);
+    if (rc) release_model(m);
+    else m->seed = seed;
+    return rc;
+}
+
+const tcb_method_ops tcb_method_neupig = {
+    .abi_version = TCB_METHOD_ABI_VERSION,
+    .name = "neupig",
+    .description = "Neu-PiG (CVPR 2026): a Poisson template of the keyframe moved per vertex by an MLP "
+                   "on preconditioned feature grids and time; barycentric read-out",
+    .create = create,
+    .fit = fit,
+    .transfer = transfer,
+    .reconstruct = reconstruct,
+    .save = save,
+    .load = load,
+    .destroy = destroy,
+};
