@@ -1,5 +1,7 @@
 #include "methods/params.h"
 
+#include <stdlib.h>
+
 #include "tcb/json.h"
 
 int tcb_params_parse(const char *params_json, const char *where, const char *const *allowed,
@@ -12,4 +14,21 @@ int tcb_params_parse(const char *params_json, const char *where, const char *con
         *out = NULL;
     }
     return rc;
+}
+
+int tcb_method_create(size_t size, const char *name, const char *params_json,
+                      int (*parse)(const char *params_json, void *obj, tcb_error *err),
+                      void (*release)(void *obj), void **self, tcb_error *err)
+{
+    *self = NULL;
+    void *obj = calloc(1, size);
+    if (!obj) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", name);
+    int rc = parse(params_json, obj, err);
+    if (rc) {
+        if (release) release(obj);
+        else free(obj);
+        return rc;
+    }
+    *self = obj;
+    return TCB_OK;
 }

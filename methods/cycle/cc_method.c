@@ -123,18 +123,14 @@ static int parse(const char *params_json, const char *where, cc_method *c, tcb_e
     return rc;
 }
 
+static int parse_params(const char *params_json, void *c, tcb_error *err)
+{
+    return parse(params_json, "cc.params", c, err);
+}
+
 static int create(const char *params_json, void **self, tcb_error *err)
 {
-    *self = NULL;
-    cc_method *c = calloc(1, sizeof *c);
-    if (!c) return tcb_fail(err, TCB_ERR_NOMEM, "cc: out of memory");
-    int rc = parse(params_json, "cc.params", c, err);
-    if (rc) {
-        free(c);
-        return rc;
-    }
-    *self = c;
-    return TCB_OK;
+    return tcb_method_create(sizeof(cc_method), "cc", params_json, parse_params, NULL, self, err);
 }
 
 static void destroy(void *self)

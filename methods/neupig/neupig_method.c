@@ -75,8 +75,9 @@ typedef struct neupig_method {
     int n_frames;
 } neupig_method;
 
-static int parse(const char *params_json, neupig_method *m, tcb_error *err)
+static int parse(const char *params_json, void *obj, tcb_error *err)
 {
+    neupig_method *m = obj;
     static const char *const keys[] = {"preset", "normals", "epochs", "points", "template_faces", "poisson_depth",
                                        "levels", "features", "hidden", "recon_points", "checkpoint_every",
                                        "divergence", NULL};
@@ -119,16 +120,7 @@ static void release_model(neupig_method *m)
 
 static int create(const char *params_json, void **self, tcb_error *err)
 {
-    *self = NULL;
-    neupig_method *m = calloc(1, sizeof *m);
-    if (!m) return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
-    int rc = parse(params_json, m, err);
-    if (rc) {
-        free(m);
-        return rc;
-    }
-    *self = m;
-    return TCB_OK;
+    return tcb_method_create(sizeof(neupig_method), "neupig", params_json, parse, NULL, self, err);
 }
 
 static void destroy(void *self)
