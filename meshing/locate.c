@@ -125,7 +125,7 @@ typedef struct search {
 static int locate_one(const search *s, const float *query, tcb_surface_point *out, float *dist2,
                       tcb_error *err)
 {
-    double p[3] = {query[0], query[1], query[2]}, best = INFINITY, w[3], bw[3] = {1, 0, 0};
+    double p[3] = {query[0], query[1], query[2]}, best = INFINITY, w[3] = {0, 0, 0}, bw[3] = {1, 0, 0};
     int32_t best_face = 0;
     for (int k = s->nf < 16 ? s->nf : 16;; k = 2 * k < s->nf ? 2 * k : s->nf) {
         int rc = tcb_nn_queryk(s->index, query, 1, k, s->idx, s->d2, err);
