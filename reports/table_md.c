@@ -221,5 +221,6 @@ void tcb_rpt_write_md(FILE *f, const tcb_rpt *r)
                "the geodesic error (docs/protocol.md): m_geo ×1e3 (path length on the target "
                "mesh over sqrt(its area), over all vertices of all pairs) and AUC_geo %% (its "
                "PCK up to 0.25, over pairs); \"-\" there: cells scored before it existed.\n\n");
+    tcb_rpt_write_presets_md(f, r);
     for (int k = 0; k < r->n_datasets; k++) write_dataset(f, r, &r->datasets[k]);
 }
