@@ -55,9 +55,10 @@ static void price_curve(const cost_curve *c, int threads, tcb_cost_price *out)
         if (c->n == 1) out->lo = out->hi = c->threads[0];
         return;
     }
-    if (a + 1 == c->n) a--; /* beyond the last: the last two's scaling */
+    if (a + 1 == c->n) a--; /* beyond the last: the last two's scaling, from the last */
+    int from = threads > c->threads[a + 1] ? a + 1 : a;
     out->lo = c->threads[a], out->hi = c->threads[a + 1];
-    out->seconds = c->seconds[a] * pow((double)threads / c->threads[a], exponent(c, a, out->extrapolated));
+    out->seconds = c->seconds[from] * pow((double)threads / c->threads[from], exponent(c, a, out->extrapolated));
 }
 
 int tcb_cost_lookup(const tcb_calibration_set *s, tcb_cost_kind kind, const char *method, const char *preset,
