@@ -148,7 +148,7 @@ long tcb_peak_rss_kb(void);
 /* The machine a calibration is made on, as JSON text (malloc'ed; NULL out
  * of memory): CPU model, cores, kernel, compiler, library versions,
  * tcbench's revision, the date and the load average; summary gets "CPU
- * model, N cores". */
+ * model, N cores, load L" (the load average at the start). */
 char *tcb_machine_describe(char *summary, size_t size);
 /* The cores OpenMP may use. */
 int tcb_cpu_count(void);

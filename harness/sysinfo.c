@@ -66,8 +66,9 @@ char *tcb_machine_describe(char *summary, size_t size)
     tcb_git_revision(rev, sizeof rev);
     strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", gmtime(&now));
     int cores = tcb_cpu_count();
-    snprintf(summary, size, "%s, %d core%s", cpu, cores, cores == 1 ? "" : "s");
     getloadavg(load, 3);
+    /* the load says how far the costs are from an idle machine's */
+    snprintf(summary, size, "%s, %d core%s, load %.1f", cpu, cores, cores == 1 ? "" : "s", load[0]);
     cJSON *m = cJSON_CreateObject();
     if (!m) return NULL;
     cJSON_AddStringToObject(m, "summary", summary);
