@@ -141,6 +141,14 @@ static int measure_all(const session *s, const measurement *m, int n, tcb_error 
     return TCB_OK;
 }
 
+/* Summaries "CPU, N cores, load L" of one machine: the same but for the load. */
+static int same_machine(const char *a, const char *b)
+{
+    const char *la = strstr(a, ", load "), *lb = strstr(b, ", load ");
+    size_t na = la ? (size_t)(la - a) : strlen(a), nb = lb ? (size_t)(lb - b) : strlen(b);
+    return na == nb && !strncmp(a, b, na);
+}
+
 /* The measured costs, and those of an earlier calibration of this very
  * machine at path that were not measured again (--only, --preset add to
  * it); a file of another machine is replaced. */
@@ -153,7 +161,7 @@ static int merge_earlier(const char *path, tcb_calibration *cal, FILE *out, tcb_
     if (!tcb_is_file(path) || tcb_read_file(path, &text, &len, &ignored)) return TCB_OK;
     int rc = tcb_calibration_parse(text, path, &old, &ignored);
     free(text);
-    if (rc || strcmp(old.machine, cal->machine) || old.n_verts != cal->n_verts) {
+    if (rc || !same_machine(old.machine, cal->machine) || old.n_verts != cal->n_verts) {
         if (!rc) fprintf(out, "replacing %s (made on %s)\n", path, old.machine);
         if (!rc) tcb_calibration_free(&old);
         return TCB_OK;
