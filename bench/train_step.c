@@ -10,8 +10,10 @@
  * autograd's double backward for mca, torch.optim.Adam), printed as the
  * ratio torch ms / C ms.
  *
- * C: a synthetic sequence (6 frames, pools of 10,000 points), one warm-up
- * step, then the mean of `iters` steps. The PyTorch peer runs after the C
+ * C: the method's own training steps (train_steps, created with {"preset":
+ * P}) on the calibration sequence (synthetic, 6 frames, pools of 10,000
+ * points), one warm-up step, then the mean of `iters` steps: the
+ * measurement `tcbench calibrate` makes (harness/step_timing.c). The PyTorch peer runs after the C
  * rows of the same (preset, method), with the same sizes, thread count and
  * warm-up; the C process waits meanwhile.
  *
@@ -43,6 +45,7 @@
  * Defaults: 5 iterations, the OpenMP thread count, all presets and methods
  * (atlasnet, dsr, mca, cc), the peers train_step_torch.py and
  * train_step_cc_torch.py next to this file run by /usr/bin/python3. */
+#include <math.h>
 #include <omp.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -53,11 +56,10 @@
 
 #include "atlas_bench.h"
 #include "cc_bench.h"
-#include "methods/atlas/train.h"
-#include "methods/cycle/train.h"
-#include "tcb/synth.h"
+#include "harness/calibration.h"
+#include "tcb/registry.h"
 
-enum { P = 10, N = 2500, FRAMES = 6, PEER_SKIPPED = 77 };
+enum { P = 10, N = TCB_DEFAULT_INPUT_POINTS, PEER_SKIPPED = 77 };
 
 typedef struct {
     const char *name;
@@ -77,11 +79,8 @@ static const cc_preset cc_presets[] = {{"cpu", {128, 64, 32, 6, 0}, 8, 500}, {"p
 
 static const struct {
     const char *name;
-    tcb_atlas_loss loss;
     int nt; /* tangents per value */
-} methods[] = {{"atlasnet", TCB_ATLAS_LOSS_CHAMFER, 0},
-               {"dsr", TCB_ATLAS_LOSS_DSR, 2},
-               {"mca", TCB_ATLAS_LOSS_METRIC, 2}};
+} methods[] = {{"atlasnet", 0}, {"dsr", 2}, {"mca", 2}};
 
 typedef struct {
     int iters, threads, torch;
@@ -93,65 +92,22 @@ typedef struct {
 
 #define die(...) bench_die("bench_train_step", __VA_ARGS__)
 
-static void make_sequence(tcb_sequence *s)
+/* Mean ms per training step of method `name` at `preset`, after one
+ * warm-up step: the measurement `tcbench calibrate` makes
+ * (tcb_time_train_steps through the method's train_steps). */
+static double time_c(const char *name, const char *preset, const tcb_sequence *seq, const options *o)
 {
+    const tcb_method_ops *ops = tcb_registry_find(name);
+    char params[64];
+    snprintf(params, sizeof params, "{\"preset\": \"%s\"}", preset);
     tcb_error err = {0};
-    if (tcb_synth_generate("quadruped_walk", 1, FRAMES, s, &err) ||
-        tcb_sequence_normalize(s, TCB_NORM_FIRST_FRAME, &err) ||
-        tcb_sequence_sample_pools(s, TCB_DEFAULT_POOL_SIZE, 1, &err))
-        die("%s", err.msg);
-    s->input_points = N, s->draw_with_replacement = 0;
-}
-
-/* Mean ms per tcb_atlas_train_step of a fresh model, after one warm-up. */
-static double time_c(const preset *pr, tcb_atlas_loss loss, const tcb_sequence *seq, int iters)
-{
-    tcb_error err = {0};
-    tcb_atlas_model *m;
-    if (tcb_atlas_model_create(pr->C, P, &m, &err)) die("%s", err.msg);
-    tcb_rng rng;
-    tcb_rng_seed_stream(&rng, 1, "bench/train_step");
-    tcb_atlas_model_init(m, &rng);
-    tcb_atlas_train_cfg cfg = {.loss = loss, .M = pr->M, .iterations = 200000, .lr = 1e-3,
-                               .alpha_mc = 0.1, .alpha_sciso = 1e-3, .delta = 1};
-    tcb_atlas_trainer *t;
-    if (tcb_atlas_trainer_create(&cfg, m, seq, 1, &t, &err)) die("%s", err.msg);
-    double value, t0 = 0;
-    for (int it = 0; it <= iters; it++) {
-        if (it == 1) t0 = bench_now_ms();
-        if (tcb_atlas_train_step(t, seq, &value, &err)) die("%s", err.msg);
-    }
-    double ms = (bench_now_ms() - t0) / iters;
-    tcb_atlas_trainer_free(t);
-    tcb_atlas_model_free(m);
-    return ms;
-}
-
-/* Mean ms per tcb_cc_train_step (after the warm-up phase: six network
- * calls) of a fresh network, after one warm-up step. */
-static double time_cc(const cc_preset *pr, const tcb_sequence *seq, int iters)
-{
-    tcb_error err = {0};
-    tcb_cc_net *net;
-    if (tcb_cc_net_create(&pr->d, &net, &err)) die("%s", err.msg);
-    tcb_rng rng;
-    tcb_rng_seed_stream(&rng, 1, "bench/train_step");
-    tcb_cc_net_init(net, &rng);
-    tcb_sequence s = *seq;
-    s.input_points = pr->N;
-    tcb_cc_train_cfg cfg = {.sampler = tcb_cc_sampler_opts_default(), .batch = pr->B, .iterations = 200000,
-                            .warmup = 0, .lr = 1e-3};
-    tcb_cc_trainer *t;
-    if (tcb_cc_trainer_create(&cfg, net, &s, 1, &t, &err)) die("%s", err.msg);
-    double value, t0 = 0;
-    for (int it = 0; it <= iters; it++) {
-        if (it == 1) t0 = bench_now_ms();
-        if (tcb_cc_train_step(t, &s, &value, &err)) die("%s", err.msg);
-    }
-    double ms = (bench_now_ms() - t0) / iters;
-    tcb_cc_trainer_free(t);
-    tcb_cc_net_free(net);
-    return ms;
+    void *self;
+    if (!ops || ops->create(params, &self, &err)) die("%s: %s", name, ops ? err.msg : "not registered");
+    tcb_fit_ctx ctx = {.seed = 1, .n_threads = o->threads};
+    tcb_step_timing t;
+    if (tcb_time_train_steps(ops, self, seq, &ctx, o->iters, INFINITY, &t, &err)) die("%s", err.msg);
+    ops->destroy(self);
+    return t.step_s * 1e3;
 }
 
 /* Runs a PyTorch peer command: 0 with *ms and *rss_kib, PEER_SKIPPED when
@@ -232,7 +188,7 @@ static void run_row(options *o, const preset *pr, int k, const tcb_sequence *seq
     double fwd, bwd, tms = 0;
     long rss = 0;
     bench_atlas_macs(pr->C, P, pr->M, 4, N, methods[k].nt, &fwd, &bwd);
-    double ms = time_c(pr, methods[k].loss, seq, o->iters);
+    double ms = time_c(methods[k].name, pr->name, seq, o);
     int rc = o->torch ? time_torch(o, pr, methods[k].name, &tms, &rss) : PEER_SKIPPED;
     print_row(o, pr->name, methods[k].name, 2 * (fwd + bwd) * 1e-9, ms, rc, tms, rss, o->script);
 }
@@ -242,7 +198,7 @@ static void run_cc_row(options *o, const cc_preset *pr, const tcb_sequence *seq)
     double fwd, bwd, tms = 0;
     long rss = 0;
     bench_cc_macs(&pr->d, pr->B, pr->N, &fwd, &bwd);
-    double ms = time_cc(pr, seq, o->iters);
+    double ms = time_c("cc", pr->name, seq, o);
     int rc = o->torch ? time_cc_torch(o, pr, &tms, &rss) : PEER_SKIPPED;
     print_row(o, pr->name, "cc", 2 * (fwd + bwd) * 1e-9, ms, rc, tms, rss, o->cc_script);
 }
@@ -283,7 +239,8 @@ int main(int argc, char **argv)
     /* before any work is created: the trainer sizes its pool from it */
     omp_set_num_threads(o.threads);
     tcb_sequence seq = {0};
-    make_sequence(&seq);
+    tcb_error err = {0};
+    if (tcb_calibration_sequence(&seq, &err)) die("%s", err.msg);
     print_header(&o);
     for (size_t i = 0; i < sizeof presets / sizeof *presets; i++) {
         int want = !o.preset || strcmp(o.preset, presets[i].name) == 0;

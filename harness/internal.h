@@ -145,6 +145,13 @@ void tcb_stop_signals_end(tcb_stop_signals *s);
 void tcb_git_revision(char *out, size_t size);
 /* Peak resident set size of this process so far, in KiB. */
 long tcb_peak_rss_kb(void);
+/* The machine a calibration is made on, as JSON text (malloc'ed; NULL out
+ * of memory): CPU model, cores, kernel, compiler, library versions,
+ * tcbench's revision, the date and the load average; summary gets "CPU
+ * model, N cores, load L" (the load average at the start). */
+char *tcb_machine_describe(char *summary, size_t size);
+/* The cores OpenMP may use. */
+int tcb_cpu_count(void);
 
 /* "synth/quadruped_walk/nearest/seed 0": how progress and logs name a cell.
  * The size fits the longest dataset, sequence and method names. */

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "harness/calibration.h"
 #include "harness/internal.h"
 #include "tcb/tcb.h"
 
@@ -20,9 +21,9 @@ enum {
     F_OUT, F_ONLY, F_FORCE, F_QUIET, F_REPORT, F_SEED, F_FRAMES, F_SEQUENCE, F_UPDATE,
     F_PLUGIN, F_THREADS, F_VERBOSE, F_SAMPLES, F_PLOT, F_ROOT, F_VARIANT, F_DRY_RUN, F_REFERENCE, F_CELL,
     F_SHARD, F_LOCK_TIMEOUT, F_DATASET, F_PRED, F_NAME, F_HELP,
-    F_N_FRAMES, F_STYLE, F_ANY_FRAME, F_RESAMPLES, F_COUNT
+    F_N_FRAMES, F_STYLE, F_ANY_FRAME, F_RESAMPLES, F_QUICK, F_PRESET, F_BUDGET, F_TASKS, F_COUNT
 };
-#define BIT(f) (1u << (f))
+#define BIT(f) (1ull << (f))
 
 static const struct {
     const char *name;
@@ -38,6 +39,8 @@ static const struct {
     [F_DATASET] = {"--dataset", 1}, [F_PRED] = {"--pred", 1},  [F_NAME] = {"--name", 1},
     [F_HELP] = {"--help", 0},    [F_N_FRAMES] = {"--count", 1}, [F_STYLE] = {"--style", 1},
     [F_ANY_FRAME] = {"--any-frame", 0}, [F_RESAMPLES] = {"--resamples", 1},
+    [F_QUICK] = {"--quick", 0},  [F_PRESET] = {"--preset", 1}, [F_BUDGET] = {"--budget", 1},
+    [F_TASKS] = {"--tasks", 1},
 };
 
 #define MAX_PLUGINS 64
@@ -60,7 +63,7 @@ typedef struct cli {
 typedef struct command {
     const char *name;
     int (*fn)(const cli *c);
-    unsigned accepts;       /* BIT(F_...) of the command's own flags */
+    unsigned long long accepts; /* BIT(F_...) of the command's own flags */
     int min_args, max_args;
     const char *arg_names;  /* for "missing ..." messages */
     const char *help;
@@ -94,7 +97,10 @@ static const struct int_flag {
     const char *cmd;
     long long min, max;
 } int_flags[] = {
+    {F_THREADS, "calibrate", 1, 0},       /* a list there (min > max: not an integer flag) */
     {F_THREADS, NULL, 1, 1024},
+    {F_BUDGET, NULL, 1, 1000000},         /* seconds */
+    {F_TASKS, NULL, 1, 1000000},          /* concurrent tasks of a Slurm array */
     {F_SEED, "datasets", 0, LLONG_MAX},  /* a generator's seed, as a config's dataset "seed" */
     {F_SEED, NULL, 0, INT_MAX},           /* a cell's seed, as a config's "seeds" */
     {F_FRAMES, "datasets", 1, 100000},    /* frames per sequence; `frames` takes a list */
@@ -108,7 +114,7 @@ static const struct int_flag *int_flag_of(const char *cmd, int f)
 {
     for (size_t k = 0; k < sizeof int_flags / sizeof int_flags[0]; k++)
         if (int_flags[k].flag == f && (!int_flags[k].cmd || (cmd && !strcmp(int_flags[k].cmd, cmd))))
-            return &int_flags[k];
+            return int_flags[k].min > int_flags[k].max ? NULL : &int_flags[k];
     return NULL;
 }
 
@@ -197,6 +203,7 @@ static int cmd_run(const cli *c)
     tcb_error err = {0};
     tcb_config cfg;
     unsigned char *mask;
+    if (c->set[F_TASKS] && !c->set[F_DRY_RUN]) return usage_error("run", "--tasks applies to --dry-run only");
     int rc = load_config(c, &cfg);
     if (rc) return rc;
     if ((rc = cell_mask(c, &cfg, &mask))) {
@@ -210,6 +217,7 @@ static int cmd_run(const cli *c)
     tcb_run_opts opts = {.output = c->value[F_OUT], .only_method = c->value[F_ONLY], .force = c->set[F_FORCE],
                          .reporter = c->set[F_DRY_RUN] ? (tcb_reporter){0} : tcb_term_progress_reporter(&tp),
                          .cells = mask, .lock_timeout_s = (double)flag_int(c, F_LOCK_TIMEOUT, 0),
+                         .tasks = (int)flag_int(c, F_TASKS, 0),
                          .interrupted = tcb_stop_signals_requested, .interrupt_arg = &stop};
     /* Before any thread exists, so that every thread blocks the signals. */
     if (tcb_stop_signals_start(&stop)) fprintf(stderr, "tcbench: cannot watch for SIGTERM; a signal kills the run\n");
@@ -497,6 +505,46 @@ static int cmd_score(const cli *c)
     return 0;
 }
 
+/* calibrate --threads: "1,2,16", kept increasing without repeats. */
+static int thread_list(const char *text, int *threads, int max, int *n)
+{
+    *n = 0;
+    for (const char *p = text; *p;) {
+        char *end;
+        errno = 0;
+        long t = strtol(p, &end, 10);
+        if (end == p || errno || t < 1 || t > 1024 || (*end && *end != ',') || (*end == ',' && !end[1]))
+            return usage_error("calibrate", "--threads: expected thread counts from 1 to 1024 separated by commas, "
+                               "got '%s'", text);
+        int at = 0;
+        while (at < *n && threads[at] < t) at++;
+        if (at == *n || threads[at] != t) {
+            if (*n == max) return usage_error("calibrate", "--threads: more than %d thread counts", max);
+            memmove(threads + at + 1, threads + at, (size_t)(*n - at) * sizeof *threads);
+            threads[at] = (int)t, (*n)++;
+        }
+        p = *end ? end + 1 : end;
+    }
+    return 0;
+}
+
+static int cmd_calibrate(const cli *c)
+{
+    enum { MAX_COUNTS = 16 };
+    char cores[16], user[TCB_PATH_MAX];
+    snprintf(cores, sizeof cores, "1,2,%d", tcb_cpu_count());
+    int threads[MAX_COUNTS], n = 0;
+    int rc = thread_list(c->set[F_THREADS] ? c->value[F_THREADS] : cores, threads, MAX_COUNTS, &n);
+    if (rc) return rc;
+    tcb_calibration_user_path(user, sizeof user);
+    const char *out = c->value[F_OUT] ? c->value[F_OUT] : user;
+    if (!out[0]) return usage_error("calibrate", "neither HOME nor XDG_CONFIG_HOME is set: give --out FILE");
+    tcb_calibrate_opts o = {threads, n, c->value[F_ONLY], c->value[F_PRESET],
+                            (double)flag_int(c, F_BUDGET, c->set[F_QUICK] ? 60 : 600), c->set[F_QUICK], out};
+    tcb_error err = {0};
+    return tcb_calibrate(&o, stdout, &err) ? fail(&err) : 0;
+}
+
 static int cmd_version(const cli *c)
 {
     (void)c;
@@ -511,9 +559,10 @@ static int cmd_help(const cli *c);
 static const command commands[] = {
     {"run", cmd_run,
      BIT(F_OUT) | BIT(F_ONLY) | BIT(F_FORCE) | BIT(F_QUIET) | BIT(F_REPORT) | BIT(F_THREADS) | BIT(F_VERBOSE) |
-         BIT(F_ROOT) | BIT(F_VARIANT) | BIT(F_DRY_RUN) | BIT(F_CELL) | BIT(F_SHARD) | BIT(F_LOCK_TIMEOUT),
+         BIT(F_ROOT) | BIT(F_VARIANT) | BIT(F_DRY_RUN) | BIT(F_CELL) | BIT(F_SHARD) | BIT(F_LOCK_TIMEOUT) |
+         BIT(F_TASKS),
      1, 1, "CONFIG",
-     "usage: tcbench run CONFIG [--root DATASET=DIR]... [--variant NAME] [--dry-run] [--out DIR]\n"
+     "usage: tcbench run CONFIG [--root DATASET=DIR]... [--variant NAME] [--dry-run [--tasks K]] [--out DIR]\n"
      "                  [--only METHOD] [--cell IDS] [--shard I/N|auto] [--lock-timeout S]\n"
      "                  [--threads N] [--force] [--quiet] [--verbose] [--report] [--plugin SO]...\n"
      "\n"
@@ -529,7 +578,11 @@ static const command commands[] = {
      "                 config's \"root\"); repeatable\n"
      "  --variant NAME the config's variant (configs/paper/*: cpu, the default, or paper);\n"
      "                 the run goes to <output>/<variant>\n"
-     "  --dry-run      list the cells, their state and an estimate of their compute; run nothing\n"
+     "  --dry-run      list the cells, their state and an estimate of their compute; run nothing.\n"
+     "                 Priced by the first calibration that measured the method: <run dir>/\n"
+     "                 calibration.json, the user's (tcbench calibrate), the built-in one\n"
+     "  --tasks K      with --dry-run: also the wall time of K concurrent one-cell tasks (a\n"
+     "                 Slurm array with %K)\n"
      "  --out DIR      run directory (default: the config's \"output\")\n"
      "  --only METHOD  run only the method with this label\n"
      "  --cell IDS     run only these cells (\"3,5-7\"; ids as 'tcbench cells' lists them)\n"
@@ -803,6 +856,37 @@ static const command commands[] = {
      "      --pred results.npz --name my_method\n"
      "  tcbench score configs/quick.json --dataset synth --sequence quadruped_walk \\\n"
      "      --pred predictions/ --name my_method\n"},
+    {"calibrate", cmd_calibrate, BIT(F_QUICK) | BIT(F_THREADS) | BIT(F_ONLY) | BIT(F_PRESET) | BIT(F_BUDGET) | BIT(F_OUT),
+     0, 0, "",
+     "usage: tcbench calibrate [--quick] [--threads T,T,...] [--only METHOD] [--preset NAME]\n"
+     "                         [--budget SECONDS] [--out FILE]\n"
+     "\n"
+     "Measures on this machine what 'tcbench run --dry-run' prices cells with: a training\n"
+     "step of every trained method at each of its presets, the method's part of an\n"
+     "evaluation pair, and the harness's scoring of a pair, at each thread count; and\n"
+     "writes them with the machine's description (CPU, cores, library versions). Each\n"
+     "measurement is a warm-up step, then steps while its share of the budget lasts (at\n"
+     "least one: the largest presets may overrun a small budget, which the last line says).\n"
+     "\n"
+     "The dry run reads, first match wins: <run dir>/calibration.json (a calibration made\n"
+     "on the nodes that run it: --out RUN_DIR/calibration.json in a job there), the user's\n"
+     "file (the default --out), the built-in one (calibration/default.json, which names\n"
+     "the machine it came from). Calibrating into an existing file of this machine keeps\n"
+     "its costs that were not measured again.\n"
+     "\n"
+     "options:\n"
+     "  --quick        a coarse pass (default budget 60 s): about a minute on 2 idle cores,\n"
+     "                 most of it the paper presets' warm-up and one step\n"
+     "  --threads T,.. the thread counts to measure (default 1, 2 and every core)\n"
+     "  --only METHOD  measure this method only\n"
+     "  --preset NAME  measure this preset only\n"
+     "  --budget S     seconds for the whole measurement (default 600; --quick 60)\n"
+     "  --out FILE     where to write (default $XDG_CONFIG_HOME/tcbench/calibration.json,\n"
+     "                 else ~/.config/tcbench/calibration.json)\n"
+     "\n"
+     "examples:\n"
+     "  tcbench calibrate --quick\n"
+     "  tcbench calibrate --only dsr --preset paper --threads 1,2,4,8\n"},
     {"version", cmd_version, 0, 0, 0, "",
      "usage: tcbench version\n"
      "\n"
@@ -837,6 +921,7 @@ static const char general_help[] =
     "  inspect   one evaluation pair as coloured meshes, checked against the run\n"
     "  frames    a few frames of a cell as a picture: checkerboard-textured surfaces or transfers\n"
     "  score     score correspondences computed elsewhere (.npy files) as a cell of a run\n"
+    "  calibrate measure step and evaluation costs on this machine for the dry run's estimates\n"
     "  version   print the version\n"
     "  help      help on a command\n"
     "\n"
@@ -890,7 +975,7 @@ static int parse_flag(const command *cmd, int argc, char **argv, int *i, cli *c)
     if (strcmp(name, "-h") == 0) snprintf(name, sizeof name, "--help");
     int f = 0;
     while (f < F_COUNT && strcmp(flags[f].name, name) != 0) f++;
-    unsigned accepted = BIT(F_PLUGIN) | BIT(F_HELP) | (cmd ? cmd->accepts : 0);
+    unsigned long long accepted = BIT(F_PLUGIN) | BIT(F_HELP) | (cmd ? cmd->accepts : 0);
     const char *where = cmd ? cmd->name : NULL;
     if (f == F_COUNT || !(accepted & BIT(f))) return usage_error(where, "unknown option '%s'", name);
     const char *value = NULL;

@@ -4,31 +4,31 @@
  * Cells are numbered in grid order (dataset, sequence, method, seed) over
  * the whole config, so an id depends only on the config. A sequence is
  * sized from its first OBJ file (or generated, for synthetic data); each
- * method estimates its own cost from its measured step costs
- * (tcb_method_ops.estimate), and the harness adds its projection and
- * metrics. */
+ * method estimates its own cost (tcb_method_ops.estimate), a trained one
+ * by naming the preset whose costs `tcbench calibrate` measured, and the
+ * harness prices it and adds its scoring of the pairs from the
+ * calibrations (harness/calibration.h). */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "harness/calibration.h"
 #include "harness/internal.h"
 #include "tcb/dfaust.h"
 #include "tcb/registry.h"
 #include "tcb/synth.h"
 
-/* The harness's projection and metrics per pair: 0.11 s at 10 002 vertices
- * (nearest on crane: 55 s for 500 pairs, one thread, Zen 4), scaled with
- * the square of the vertex count, an upper bound (the rank compares only
- * nearby vertices, docs/protocol.md). */
-#define METRICS_S_PER_VERT2 (0.11 / (10002.0 * 10002.0))
-
 typedef struct plan_totals {
     int cells, done, to_run, unknown;  /* unknown: cells to run with a part not estimated */
     double seconds;  /* the estimated parts of the cells to run */
+    double *cell_s;  /* [to_run] each one's estimated seconds, in id order (--tasks) */
+    int cap;
 } plan_totals;
 
 static void duration_text(double s, char *out, size_t size)
 {
     if (s < 0) snprintf(out, size, "?");
+    else if (s < 10) snprintf(out, size, "%.1f s", s);
     else if (s < 90) snprintf(out, size, "%.0f s", s);
     else if (s < 5400) snprintf(out, size, "%.0f min", s / 60);
     else snprintf(out, size, "%.1f h", s / 3600);
@@ -88,24 +88,42 @@ static void cell_state(const char *run_dir, const tcb_dataset_spec *d, const cha
     cell_state_message(run_dir, d, seq, m, seed, out, size, NULL, 0);
 }
 
-static void estimate_cell(const tcb_method_spec *m, const tcb_cost_query *q, tcb_cost_estimate *e)
+static void estimate_cell(const tcb_calibration_set *cals, const tcb_method_spec *m, const tcb_cost_query *q,
+                          tcb_cost_estimate *e)
 {
     const tcb_method_ops *ops = tcb_registry_find(m->method); /* checked before */
     void *self = NULL;
     tcb_error err = {0};
+    memset(e, 0, sizeof *e);
     e->fit_s = e->eval_s = -1;
     snprintf(e->basis, sizeof e->basis, "the method gives no estimate");
     if (ops->abi_version < 2 || !ops->estimate || ops->create(m->params_json, &self, &err)) return;
     ops->estimate(self, q, e);
     ops->destroy(self);
-    if (e->eval_s >= 0 && q->n_verts > 0)
-        e->eval_s += q->n_pairs * METRICS_S_PER_VERT2 * (double)q->n_verts * q->n_verts;
-    else if (q->n_verts <= 0)
-        e->eval_s = -1;
+    tcb_cost_price_cell(cals, ops->name, q, e);
+}
+
+/* The wall time of the cells' seconds run as `tasks` concurrent one-cell
+ * tasks taking the cells in id order, each as a task ends (a Slurm array
+ * with %tasks). */
+static double tasks_wall_time(const double *cell_s, int n, int tasks)
+{
+    double *end = calloc((size_t)tasks, sizeof *end), wall = 0;
+    if (!end) return -1;
+    for (int k = 0; k < n; k++) {
+        int first = 0; /* the task slot that frees first */
+        for (int t = 1; t < tasks; t++)
+            if (end[t] < end[first]) first = t;
+        end[first] += cell_s[k];
+        if (end[first] > wall) wall = end[first];
+    }
+    free(end);
+    return wall;
 }
 
 typedef struct plan_walk {
     FILE *out;
+    const tcb_calibration_set *cals;
     const tcb_config *cfg;
     const tcb_run_opts *opts;
     const char *run_dir;
@@ -136,6 +154,18 @@ static void sequence_header(plan_walk *w, const tcb_dataset_spec *d, const char 
     fprintf(w->out, "  %4s  %-24s %4s  %-10s %9s %9s  %s\n", "id", "method", "seed", "state", "fit", "eval", "basis");
 }
 
+static int add_cell_seconds(plan_totals *t, double seconds)
+{
+    if (t->to_run > t->cap) {
+        int cap = t->cap ? 2 * t->cap : 64;
+        double *grown = realloc(t->cell_s, (size_t)cap * sizeof *grown);
+        if (!grown) return TCB_ERR_NOMEM;
+        t->cell_s = grown, t->cap = cap;
+    }
+    t->cell_s[t->to_run - 1] = seconds;
+    return TCB_OK;
+}
+
 static int plan_cell(void *ctx, const tcb_grid_cell *c)
 {
     plan_walk *w = ctx;
@@ -143,7 +173,7 @@ static int plan_cell(void *ctx, const tcb_grid_cell *c)
     if (w->current != c->sequence) sequence_header(w, c->dataset, c->sequence->name);
     w->current = c->sequence;
     tcb_cost_estimate e;
-    estimate_cell(c->method, &w->q, &e);
+    estimate_cell(w->cals, c->method, &w->q, &e);
     char state[TCB_PATH_MAX];
     cell_state(w->run_dir, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state);
     int runs = w->opts->force || !strcmp(state, "missing") || !strcmp(state, "unreadable") || !strcmp(state, "failed");
@@ -159,8 +189,33 @@ static int plan_cell(void *ctx, const tcb_grid_cell *c)
     }
     w->t.to_run++;
     w->t.unknown += e.fit_s < 0 || e.eval_s < 0;
-    w->t.seconds += (e.fit_s > 0 ? e.fit_s : 0) + (e.eval_s > 0 ? e.eval_s : 0);
-    return TCB_OK;
+    double seconds = (e.fit_s > 0 ? e.fit_s : 0) + (e.eval_s > 0 ? e.eval_s : 0);
+    w->t.seconds += seconds;
+    return add_cell_seconds(&w->t, seconds);
+}
+
+/* The calibrations in the order they are read. */
+static void print_sources(FILE *out, const tcb_calibration_set *s)
+{
+    fprintf(out, "costs from (first match wins):");
+    for (int k = 0; k < s->n; k++)
+        fprintf(out, "%s %s (%s)", k ? ";" : "", s->c[k].origin, s->c[k].machine);
+    fprintf(out, "\n");
+}
+
+static void print_totals(FILE *out, const plan_totals *t, int tasks)
+{
+    char total[32];
+    duration_text(t->seconds, total, sizeof total);
+    fprintf(out, "cells: %d, %d finished, %d to run: about %s of wall time one after another", t->cells, t->done,
+            t->to_run, total);
+    if (t->unknown)
+        fprintf(out, ", plus what is unknown of %d cell%s (\"?\" above)", t->unknown, t->unknown == 1 ? "" : "s");
+    fprintf(out, "\n");
+    if (tasks < 1) return;
+    duration_text(tasks_wall_time(t->cell_s, t->to_run, tasks), total, sizeof total);
+    fprintf(out, "as %d concurrent one-cell tasks (a Slurm array with %%%d), in id order: about %s of wall time%s\n",
+            tasks, tasks, total, t->unknown ? ", the unknown parts left out" : "");
 }
 
 int tcb_run_dry(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_error *err)
@@ -169,18 +224,18 @@ int tcb_run_dry(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_
     int rc = tcb_harness_load_plugins(cfg, err);
     if (!rc) rc = tcb_run_check_methods(cfg, opts, err);
     if (rc) return rc;
+    tcb_calibration_set cals;
+    if (!rc) rc = tcb_calibration_set_load(run_dir, &cals, err);
+    if (rc) return rc;
     fprintf(out, "%s: %s, %d thread%s per cell\n", cfg->path, run_dir, cfg->threads, cfg->threads == 1 ? "" : "s");
-    plan_walk w = {out, cfg, opts, run_dir, NULL, {0}, {0}};
-    tcb_grid_for_each(cfg, plan_cell, &w);
-    plan_totals t = w.t;
-    char total[32];
-    duration_text(t.seconds, total, sizeof total);
-    fprintf(out, "cells: %d, %d finished, %d to run: about %s of wall time one after another", t.cells, t.done,
-            t.to_run, total);
-    if (t.unknown)
-        fprintf(out, ", plus what is unknown of %d cell%s (\"?\" above)", t.unknown, t.unknown == 1 ? "" : "s");
-    fprintf(out, "\n");
-    return TCB_OK;
+    print_sources(out, &cals);
+    plan_walk w = {out, &cals, cfg, opts, run_dir, NULL, {0}, {0}};
+    rc = tcb_grid_for_each(cfg, plan_cell, &w);
+    if (rc) rc = tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
+    else print_totals(out, &w.t, opts->tasks);
+    free(w.t.cell_s);
+    tcb_calibration_set_free(&cals);
+    return rc;
 }
 
 typedef struct list_walk {

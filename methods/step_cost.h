@@ -1,22 +1,14 @@
-/* The measured cost of one training step, and the dry-run estimate a
- * training method derives from it (tcb_method_ops.estimate). */
+/* The dry-run estimate of a trained method whose costs `tcbench calibrate`
+ * measures per preset (tcb_method_ops.presets, .train_steps): the harness
+ * prices the fit's steps and the evaluation from the calibration. */
 #ifndef TCB_METHODS_STEP_COST_H
 #define TCB_METHODS_STEP_COST_H
 
 #include "tcb/method.h"
 
-/* Seconds per step with 1 and with 2 threads, as measured by
- * bench/bench_train_step on `machine`; 0 where not measured. */
-typedef struct tcb_step_cost {
-    double s1, s2;
-    const char *machine;
-} tcb_step_cost;
-
-/* fit = steps × the cost for q->n_threads (2 or more use s2: the training
- * step scales no further on the machines we measured), eval = the pairs ×
- * eval_pair_s; `unknown` (NULL when the cost is known) says why not
- * instead. */
-void tcb_step_cost_estimate(const tcb_step_cost *c, long long steps, double eval_pair_s,
-                            const tcb_cost_query *q, const char *unknown, tcb_cost_estimate *out);
+/* A fit of `steps` steps of presets[preset]; preset -1 (a size differs from
+ * every preset) is unknown, and basis says why. */
+void tcb_step_cost_estimate(const char *method, const char *const *presets, int preset, long long steps,
+                            tcb_cost_estimate *out);
 
 #endif

@@ -41,10 +41,11 @@ extern "C" {
 #endif
 
 /* 2 added `estimate`, 3 `surface`, 4 `prepare_pairs` and the reconstruct
- * that declines (TCB_ERR_UNSUPPORTED); tables of older versions still load,
- * and the harness reads no member their version did not have (their tables
- * end before it). */
-#define TCB_METHOD_ABI_VERSION 4
+ * that declines (TCB_ERR_UNSUPPORTED), 5 `presets`, `train_steps` and the
+ * estimate priced by calibrated costs (tcb_cost_estimate.steps, .preset);
+ * tables of older versions still load, and the harness reads no member
+ * their version did not have (their tables end before it). */
+#define TCB_METHOD_ABI_VERSION 5
 #define TCB_METHOD_ABI_OLDEST 1
 
 typedef struct tcb_fit_ctx {
@@ -79,12 +80,22 @@ typedef struct tcb_cost_query {
     int n_threads;          /* threads of the cell */
 } tcb_cost_query;
 
-/* Seconds of wall time on the machine the method's step costs were measured
- * on (say which in `basis`); negative: unknown (for example a cost that
- * grows with the vertex count when the data are absent). */
+/* Seconds of wall time on the machine the method's costs were measured on
+ * (say which in `basis`); negative: unknown (for example a cost that grows
+ * with the vertex count when the data are absent).
+ *
+ * From abi_version 5 a trained method may leave the pricing to the
+ * harness: it names the preset (one of its `presets`) whose costs
+ * `tcbench calibrate` measured and the training steps a fit takes, and the
+ * harness sets fit_s, eval_s and basis from the calibration of (method,
+ * preset, the cell's threads). The harness clears both before the call;
+ * a method whose configuration no preset prices leaves preset empty and
+ * says why in basis, with fit_s and eval_s negative. */
 typedef struct tcb_cost_estimate {
     double fit_s, eval_s;
     char basis[200];        /* "40 000 steps x 63.5 ms (bench_train_step, 1 thread)" */
+    long long steps;        /* abi_version >= 5: training steps of a fit */
+    char preset[32];        /* abi_version >= 5: the calibrated preset pricing them; "" none */
 } tcb_cost_estimate;
 
 /* A method's surface of one frame as a triangle mesh parametrised by
@@ -173,6 +184,22 @@ typedef struct tcb_method_ops {
      * the cell's eval_s. */
     int (*prepare_pairs)(void *self, const tcb_sequence *seq, const int *pairs, int first, int n,
                          const tcb_fit_ctx *ctx, tcb_error *err);
+
+    /* Optional (NULL: none; read only from tables of abi_version >= 5).
+     * The configurations `tcbench calibrate` measures, NULL-terminated: a
+     * method created with params {"preset": NAME} for each NAME, whose
+     * estimate then names the preset that prices it. */
+    const char *const *presets;
+
+    /* Optional (NULL: not calibrated; abi_version >= 5). For `tcbench
+     * calibrate` and bench_train_step: the first call starts a training of
+     * this created, unfitted method on seq (ctx's seed; the caller has set
+     * the OpenMP thread count to ctx->n_threads), every call runs n more
+     * steps of it (the steps a fit's step count counts, in the phase that
+     * dominates the fit); the caller times the calls. Afterwards the method
+     * is fitted with the weights of the steps done, so that transfer and
+     * reconstruct can be timed on seq too. */
+    int (*train_steps)(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, long long n, tcb_error *err);
 } tcb_method_ops;
 
 typedef const tcb_method_ops *const *(*tcb_plugin_entry_fn)(int *count);

@@ -32,6 +32,8 @@ typedef struct tcb_run_opts {
      * TCB_ERR_INTERRUPTED. */
     int (*interrupted)(const void *arg);
     const void *interrupt_arg;
+    int tasks;               /* tcb_run_dry: also the wall time of this many concurrent
+                              * one-cell tasks (a Slurm array's); 0: not asked */
 } tcb_run_opts;
 
 #define TCB_LOCK_TIMEOUT_DEFAULT_S 600.0

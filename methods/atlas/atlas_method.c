@@ -47,6 +47,7 @@ typedef struct atlas_method {
     long long checkpoint_every; /* iterations between training checkpoints; 0: none */
     uint64_t seed;              /* of the fit: the UV cache's stream */
     tcb_atlas_model *model;     /* NULL before fit or load */
+    tcb_atlas_trainer *steps;   /* train_steps' training of model; NULL: none */
     tcb_atlas_eval_state eval; /* UV sets and workspaces of the evaluation */
     const tcb_sequence *last_seq; /* the last pair evaluated: (last_seq, last_i, last_j) */
     int last_i, last_j, n_pred;
@@ -117,6 +118,8 @@ static void forget_pair(atlas_method *a)
 /* A fresh model initialised from (seed, "atlas/init"). */
 static int new_model(atlas_method *a, uint64_t seed, tcb_error *err)
 {
+    tcb_atlas_trainer_free(a->steps); /* it trains the model freed here */
+    a->steps = NULL;
     tcb_atlas_model_free(a->model);
     a->model = NULL;
     forget_pair(a);
@@ -258,6 +261,7 @@ static void destroy(void *self)
 {
     atlas_method *a = self;
     if (!a) return;
+    tcb_atlas_trainer_free(a->steps);
     tcb_atlas_model_free(a->model);
     tcb_atlas_eval_state_free(&a->eval);
     free(a->pred);
@@ -304,29 +308,23 @@ static int load(void *self, const tcb_sequence *seq, const char *path, tcb_error
     return rc;
 }
 
-/* Seconds per training step, bench_train_step on 2 Zen 4 cores, idle
- * (docs/protocol.md, the preset table); 0: not measured. */
-static const tcb_step_cost step_costs[][3] = {
-    /*            atlasnet                     dsr                          mca */
-    [0] = {{0, 0.30, "Zen 4"}, {0, 0, "Zen 4"}, {0, 0.72, "Zen 4"}},           /* paper */
-    [1] = {{0.0408, 0.0247, "Zen 4"}, {0, 0.0356, "Zen 4"}, {0.0635, 0.0352, "Zen 4"}}, /* cpu */
-};
-/* An evaluation pair: two forward passes, the collapse test, the regular
- * UV samples and the nearest-neighbour transfer, with the harness's
- * metrics: 36.2 CPU-seconds for a cat cell at the cpu preset, 1 thread
- * (perf stat task-clock, 10 training steps and the load included; mca,
- * seed 0, 2026-12-02, after the evaluation kept its workspaces), i.e.
- * about 0.065 s a pair on an idle core. */
-#define EVAL_PAIR_S 0.065
+/* tcb_method_ops.train_steps: fit's training, n steps at a time. */
+static int train_steps(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, long long n, tcb_error *err)
+{
+    atlas_method *a = self;
+    int rc = a->steps ? TCB_OK : new_model(a, ctx->seed, err);
+    if (!rc && !a->steps) rc = tcb_atlas_trainer_create(&a->cfg, a->model, seq, ctx->seed, &a->steps, err);
+    double loss;
+    for (long long k = 0; !rc && k < n; k++) rc = tcb_atlas_train_step(a->steps, seq, &loss, err);
+    if (rc) tcb_error_prefix(err, "%s: ", a->name);
+    return rc;
+}
 
 static void estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out)
 {
+    (void)q;
     const atlas_method *a = self;
-    int loss = a->cfg.loss == TCB_ATLAS_LOSS_CHAMFER ? 0 : a->cfg.loss == TCB_ATLAS_LOSS_DSR ? 1 : 2;
-    int measured = a->preset == 0 || a->preset == 1;
-    tcb_step_cost_estimate(measured ? &step_costs[a->preset][loss] : NULL, a->cfg.iterations, EVAL_PAIR_S, q,
-                           measured ? NULL : "no step cost measured for these sizes (preset tiny or overridden)",
-                           out);
+    tcb_step_cost_estimate(a->name, preset_names, a->preset, a->cfg.iterations, out);
 }
 
 /* ---- the three tables ---------------------------------------------------- */
@@ -339,7 +337,8 @@ static void estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out
     const tcb_method_ops tcb_method_##id = {                                                                 \
         .abi_version = TCB_METHOD_ABI_VERSION, .name = #id, .description = desc, .create = id##_create,      \
         .fit = fit, .transfer = transfer, .reconstruct = reconstruct, .save = save, .load = load,            \
-        .destroy = destroy, .estimate = estimate, .surface = surface,                                        \
+        .destroy = destroy, .estimate = estimate, .surface = surface, .presets = preset_names,               \
+        .train_steps = train_steps,                                                                          \
     };
 
 ATLAS_METHOD(atlasnet, TCB_ATLAS_LOSS_CHAMFER, "AtlasNet: PointNet + patch decoders, Chamfer loss only")

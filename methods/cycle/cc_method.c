@@ -69,6 +69,8 @@ typedef struct cc_method {
     long long checkpoint_every;
     uint64_t seed;              /* of the fit */
     tcb_cc_net *net;            /* NULL before fit or load */
+    tcb_cc_trainer *steps;      /* train_steps' training of net; NULL: none */
+    tcb_sequence steps_seq;     /* its view of the sequence (train_view) */
     tcb_cc_frame_box *boxes;    /* [n_frames] of the fitted sequence */
     int n_frames;
 } cc_method;
@@ -137,6 +139,7 @@ static void destroy(void *self)
 {
     cc_method *c = self;
     if (!c) return;
+    tcb_cc_trainer_free(c->steps);
     tcb_cc_net_free(c->net);
     free(c->boxes);
     free(c);
@@ -146,6 +149,8 @@ static void destroy(void *self)
  * frame boxes of seq. */
 static int new_net(cc_method *c, const tcb_sequence *seq, uint64_t seed, int init, tcb_error *err)
 {
+    tcb_cc_trainer_free(c->steps); /* it trains the net freed here */
+    c->steps = NULL;
     tcb_cc_net_free(c->net), free(c->boxes);
     c->net = NULL, c->boxes = NULL, c->seed = seed, c->n_frames = seq->n_frames;
     int rc = tcb_cc_net_create(&c->d, &c->net, err);
@@ -190,12 +195,19 @@ static int fit_load(void *f, const char *path, double *seconds, tcb_error *err)
     return tcb_cc_train_ckpt_load(a->t, a->seq, a->seed, path, seconds, err);
 }
 
+/* The sequence as the training sees it: clouds of `points` points, a view
+ * that differs only there. */
+static tcb_sequence train_view(const cc_method *c, const tcb_sequence *seq)
+{
+    tcb_sequence v = *seq;
+    if (c->points > 0) v.input_points = c->points;
+    return v;
+}
+
 static int fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_error *err)
 {
     cc_method *c = self;
-    /* training clouds of `points` points: a sequence view that differs only there */
-    tcb_sequence train_seq = *seq;
-    if (c->points > 0) train_seq.input_points = c->points;
+    tcb_sequence train_seq = train_view(c, seq);
     cc_fit f = {.seq = &train_seq, .seed = ctx->seed};
     int rc = new_net(c, seq, ctx->seed, 1, err);
     if (!rc) rc = tcb_cc_trainer_create(&c->cfg, c->net, &train_seq, ctx->seed, &f.t, err);
@@ -312,23 +324,31 @@ static int load(void *self, const tcb_sequence *seq, const char *path, tcb_error
     return rc;
 }
 
-/* Seconds per training step, bench_train_step --method cc on 2 Zen 4
- * cores, idle (docs/protocol.md); 0: not measured. */
-static const tcb_step_cost step_costs[] = {
-    {0, 4.5, "Zen 4"},        /* paper */
-    {0.1799, 0.1195, "Zen 4"}, /* cpu */
-};
-/* An evaluation pair (two encodings, the deformation of frame i's vertices):
- * 3.6 s for the cat's 500 pairs at the cpu preset. */
-#define EVAL_PAIR_S 0.0072
+/* tcb_method_ops.train_steps: fit's training, n steps at a time, after
+ * the warm-up phase (the self-reconstruction term of the first few per
+ * cent of the iterations), whose steps dominate the fit. */
+static int train_steps(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, long long n, tcb_error *err)
+{
+    cc_method *c = self;
+    int rc = TCB_OK;
+    if (!c->steps) {
+        tcb_cc_train_cfg cfg = c->cfg;
+        cfg.warmup = 0;
+        rc = new_net(c, seq, ctx->seed, 1, err);
+        c->steps_seq = train_view(c, seq);
+        if (!rc) rc = tcb_cc_trainer_create(&cfg, c->net, &c->steps_seq, ctx->seed, &c->steps, err);
+    }
+    double loss;
+    for (long long k = 0; !rc && k < n; k++) rc = tcb_cc_train_step(c->steps, &c->steps_seq, &loss, err);
+    if (rc) tcb_error_prefix(err, "cc: ");
+    return rc;
+}
 
 static void estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out)
 {
+    (void)q;
     const cc_method *c = self;
-    int measured = c->preset == 0 || c->preset == 1;
-    tcb_step_cost_estimate(measured ? &step_costs[c->preset] : NULL, c->cfg.iterations, EVAL_PAIR_S, q,
-                           measured ? NULL : "no step cost measured for these sizes (preset short, tiny or overridden)",
-                           out);
+    tcb_step_cost_estimate("cc", preset_names, c->preset, c->cfg.iterations, out);
 }
 
 const tcb_method_ops tcb_method_cc = {
@@ -343,4 +363,6 @@ const tcb_method_ops tcb_method_cc = {
     .load = load,
     .destroy = destroy,
     .estimate = estimate,
+    .presets = preset_names,
+    .train_steps = train_steps,
 };

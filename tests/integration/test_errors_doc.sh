@@ -345,6 +345,24 @@ section "Comparisons (\`tcbench compare RUN A B\`)"
 row "an unknown method label" "$TCBENCH" compare runs/grid nearest nricpp
 row "a sequence without cells of both" "$TCBENCH" compare runs/grid nearest nricp --sequence horse
 
+# ---- calibrations
+section "Calibrations (\`tcbench calibrate\`; \`<run>/calibration.json\`, the user's, read by \`run --dry-run\`)"
+mkdir -p runs/cal
+cal() { printf '{"format": "tcbench-calibration 1", "machine": {"summary": "m"}, "sequence": {"vertices": 9}, "costs": [%s]}' "$1" > runs/cal/calibration.json; }
+cal ''
+sed -i 's/tcbench-calibration 1/tcbench-calibration 0/' runs/cal/calibration.json
+row "another format" run split.json --out runs/cal --dry-run
+cal '{"kind": "step", "method": "cc", "preset": "tiny", "threads": 0, "seconds": 1, "samples": 1}'
+row "a cost at 0 threads" run split.json --out runs/cal --dry-run
+cal '{"kind": "walk", "method": "cc", "preset": "tiny", "threads": 1, "seconds": 1, "samples": 1}'
+row "an unknown kind of cost" run split.json --out runs/cal --dry-run
+printf '{"format": "tcbench-calibration 1", "sequence": {"vertices": 9}, "costs": []}' > runs/cal/calibration.json
+row "no machine" run split.json --out runs/cal --dry-run
+row "\`--only\` a method that does not train in steps" "$TCBENCH" calibrate --only nearest --out c.json
+row "\`--preset\` none of the method's" "$TCBENCH" calibrate --only cc --preset huge --out c.json
+row "\`--threads\` not a list of counts" "$TCBENCH" calibrate --threads 1,,2 --out c.json
+row "\`run --tasks\` without \`--dry-run\`" run split.json --tasks 2
+
 # ---- command line
 section "Command-line flags (every command; checked before anything is read)"
 row "\`--threads 0\`" run split.json --threads 0

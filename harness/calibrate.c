@@ -1,0 +1,228 @@
+/* `tcbench calibrate`: the costs the dry run prices cells with, measured on
+ * this machine (harness/calibration.h).
+ *
+ * Every registered method with train_steps, at each of its presets and
+ * each thread count asked, is one measurement: a warm-up step, then steps
+ * until its share of the budget (what is left, over the measurements left)
+ * is spent, at least one and at most MAX_STEPS; then a few evaluation
+ * pairs, which also time the harness's scoring. A measurement whose
+ * warm-up and one step exceed its share overruns the budget, which the
+ * closing line says. */
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness/calibration.h"
+#include "harness/internal.h"
+#include "tcb/fsutil.h"
+#include "tcb/registry.h"
+
+enum { MAX_STEPS = 50, QUICK_MAX_STEPS = 5, EVAL_PAIRS = 6, QUICK_EVAL_PAIRS = 1 };
+
+typedef struct measurement {
+    const tcb_method_ops *ops;
+    const char *preset;
+    int threads;
+} measurement;
+
+static int calibrated(const tcb_method_ops *ops)
+{
+    return ops->abi_version >= 5 && ops->train_steps && ops->presets && ops->presets[0];
+}
+
+/* Appends ops's measurements (its presets, or o->preset, x the thread
+ * counts) to m unless NULL; returns the presets. */
+static int plan_method(const tcb_calibrate_opts *o, const tcb_method_ops *ops, measurement *m, int *n)
+{
+    int found = 0;
+    for (int p = 0; ops->presets[p]; p++) {
+        if (o->preset && strcmp(o->preset, ops->presets[p])) continue;
+        found++;
+        for (int t = 0; m && t < o->n_threads; t++) m[(*n)++] = (measurement){ops, ops->presets[p], o->threads[t]};
+    }
+    return found;
+}
+
+/* The measurements, in registry order; with m NULL only counted into *n.
+ * --only or --preset naming nothing measurable is bad input. */
+static int plan(const tcb_calibrate_opts *o, measurement *m, int *n, tcb_error *err)
+{
+    int methods = 0, presets = 0, counted = 0;
+    for (int k = 0; k < tcb_registry_count(); k++) {
+        const tcb_method_ops *ops = tcb_registry_get(k);
+        if (!calibrated(ops) || (o->method && strcmp(o->method, ops->name))) continue;
+        methods++;
+        presets += plan_method(o, ops, m, &counted);
+    }
+    if (o->method && !methods)
+        return tcb_fail(err, TCB_ERR_INPUT, "calibrate: --only %s: no method of that name trains in steps", o->method);
+    if (o->preset && !presets)
+        return tcb_fail(err, TCB_ERR_INPUT, "calibrate: --preset %s: no preset of that name%s%s", o->preset,
+                        o->method ? " in " : "", o->method ? o->method : "");
+    *n = m ? counted : presets * o->n_threads;
+    return TCB_OK;
+}
+
+/* The costs of one measurement into cal; the pairs' scoring summed into
+ * score[threads index]. */
+typedef struct session {
+    const tcb_calibrate_opts *o;
+    const tcb_sequence *seq;
+    tcb_calibration *cal;
+    double *score_s;
+    int *score_n;
+    FILE *out;
+} session;
+
+static int add(tcb_calibration *cal, tcb_cost_kind kind, const measurement *m, double s, int samples, tcb_error *err)
+{
+    tcb_cost_entry e = {kind, "", "", m->threads, samples, s};
+    snprintf(e.method, sizeof e.method, "%s", m->ops->name);
+    snprintf(e.preset, sizeof e.preset, "%s", m->preset);
+    return tcb_calibration_add(cal, &e, err);
+}
+
+static int measure(const session *s, const measurement *m, int t_index, double share, tcb_error *err)
+{
+    char params[128];
+    snprintf(params, sizeof params, "{\"preset\": \"%s\"}", m->preset);
+    void *self;
+    int rc = m->ops->create(params, &self, err);
+    if (rc) return rc;
+    tcb_fit_ctx ctx = {.seed = 0, .n_threads = m->threads};
+    tcb_step_timing t;
+    double method_s = 0, score_s = 0;
+    int pairs = s->o->quick ? QUICK_EVAL_PAIRS : EVAL_PAIRS;
+    rc = tcb_time_train_steps(m->ops, self, s->seq, &ctx, s->o->quick ? QUICK_MAX_STEPS : MAX_STEPS, 0.8 * share, &t,
+                              err);
+    if (!rc) rc = tcb_time_eval_pairs(m->ops, self, s->seq, pairs, &method_s, &score_s, err);
+    m->ops->destroy(self);
+    if (!rc) rc = add(s->cal, TCB_COST_STEP, m, t.step_s, t.steps, err);
+    if (!rc) rc = add(s->cal, TCB_COST_EVAL_PAIR, m, method_s, pairs, err);
+    if (rc) return rc;
+    s->score_s[t_index] += score_s * pairs, s->score_n[t_index] += pairs;
+    fprintf(s->out, "%9.1f ms/step (%2d steps after a %.1f s warm-up) %8.1f ms/pair\n", t.step_s * 1e3, t.steps,
+            t.first_s, method_s * 1e3);
+    return TCB_OK;
+}
+
+static int thread_index(const tcb_calibrate_opts *o, int threads)
+{
+    int k = 0;
+    while (o->threads[k] != threads) k++;
+    return k;
+}
+
+/* Every measurement, each announced before it starts. */
+static int measure_all(const session *s, const measurement *m, int n, tcb_error *err)
+{
+    double t0 = tcb_now_seconds();
+    for (int k = 0; k < n; k++) {
+        double left = s->o->budget_s - (tcb_now_seconds() - t0);
+        fprintf(s->out, "[%2d/%d] %-9s %-6s %2d thread%s ", k + 1, n, m[k].ops->name, m[k].preset, m[k].threads,
+                m[k].threads == 1 ? " " : "s");
+        fflush(s->out);
+        int rc = measure(s, &m[k], thread_index(s->o, m[k].threads), left / (n - k), err);
+        if (rc) {
+            fprintf(s->out, "failed\n");
+            tcb_error_prefix(err, "calibrate %s preset %s, %d threads: ", m[k].ops->name, m[k].preset, m[k].threads);
+            return rc;
+        }
+    }
+    for (int t = 0; t < s->o->n_threads; t++) {
+        tcb_cost_entry e = {TCB_COST_SCORE_PAIR, "", "", s->o->threads[t], s->score_n[t], 0};
+        e.seconds = s->score_n[t] ? s->score_s[t] / s->score_n[t] : 0;
+        int rc = s->score_n[t] ? tcb_calibration_add(s->cal, &e, err) : TCB_OK;
+        if (rc) return rc;
+        if (s->score_n[t])
+            fprintf(s->out, "scoring a pair (projection, metrics, geodesic error), %d thread%s: %.1f ms at %d vertices\n",
+                    e.threads, e.threads == 1 ? "" : "s", e.seconds * 1e3, s->seq->n_verts);
+    }
+    return TCB_OK;
+}
+
+/* Summaries "CPU, N cores, load L" of one machine: the same but for the load. */
+static int same_machine(const char *a, const char *b)
+{
+    const char *la = strstr(a, ", load "), *lb = strstr(b, ", load ");
+    size_t na = la ? (size_t)(la - a) : strlen(a), nb = lb ? (size_t)(lb - b) : strlen(b);
+    return na == nb && !strncmp(a, b, na);
+}
+
+/* The measured costs, and those of an earlier calibration of this very
+ * machine at path that were not measured again (--only, --preset add to
+ * it); a file of another machine is replaced. */
+static int merge_earlier(const char *path, tcb_calibration *cal, FILE *out, tcb_error *err)
+{
+    char *text;
+    size_t len;
+    tcb_calibration old;
+    tcb_error ignored = {0};
+    if (!tcb_is_file(path) || tcb_read_file(path, &text, &len, &ignored)) return TCB_OK;
+    int rc = tcb_calibration_parse(text, path, &old, &ignored);
+    free(text);
+    if (rc || !same_machine(old.machine, cal->machine) || old.n_verts != cal->n_verts) {
+        if (!rc) fprintf(out, "replacing %s (made on %s)\n", path, old.machine);
+        if (!rc) tcb_calibration_free(&old);
+        return TCB_OK;
+    }
+    int measured = cal->n;
+    for (int k = 0; !rc && k < old.n; k++) {
+        const tcb_cost_entry *e = &old.entries[k];
+        int again = 0;
+        for (int q = 0; q < measured && !again; q++) {
+            const tcb_cost_entry *f = &cal->entries[q];
+            again = f->kind == e->kind && f->threads == e->threads && !strcmp(f->method, e->method) &&
+                    !strcmp(f->preset, e->preset);
+        }
+        if (!again) rc = tcb_calibration_add(cal, e, err);
+    }
+    tcb_calibration_free(&old);
+    return rc;
+}
+
+static int write_out(const tcb_calibrate_opts *o, tcb_calibration *cal, FILE *out, tcb_error *err)
+{
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", o->out_path);
+    char *slash = strrchr(dir, '/');
+    int rc = slash && slash != dir ? (*slash = '\0', tcb_mkdirs(dir, err)) : TCB_OK;
+    if (!rc) rc = merge_earlier(o->out_path, cal, out, err);
+    if (!rc) rc = tcb_calibration_write(cal, o->out_path, err);
+    return rc;
+}
+
+int tcb_calibrate(const tcb_calibrate_opts *o, FILE *out, tcb_error *err)
+{
+    int n = 0;
+    int rc = plan(o, NULL, &n, err);
+    measurement *m = rc ? NULL : calloc(n ? (size_t)n : 1, sizeof *m);
+    double *score_s = rc ? NULL : calloc((size_t)o->n_threads, sizeof *score_s);
+    int *score_n = rc ? NULL : calloc((size_t)o->n_threads, sizeof *score_n);
+    if (!rc && (!m || !score_s || !score_n)) rc = tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
+    if (!rc) rc = plan(o, m, &n, err);
+    tcb_sequence seq = {0};
+    tcb_calibration cal = {0};
+    if (!rc) rc = tcb_calibration_sequence(&seq, err);
+    if (!rc && !(cal.machine_json = tcb_machine_describe(cal.machine, sizeof cal.machine)))
+        rc = tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
+    if (!rc) {
+        cal.n_verts = seq.n_verts;
+        fprintf(out, "calibrating on %s: %d measurements in a budget of %.0f s (%s)\n", cal.machine, n, o->budget_s,
+                o->quick ? "quick: coarse" : "a warm-up step, then steps while the budget lasts");
+    }
+    int prev = omp_get_max_threads();
+    double t0 = tcb_now_seconds();
+    session s = {o, &seq, &cal, score_s, score_n, out};
+    if (!rc) rc = measure_all(&s, m, n, err);
+    omp_set_num_threads(prev);
+    double took = tcb_now_seconds() - t0;
+    if (!rc) rc = write_out(o, &cal, out, err);
+    if (!rc)
+        fprintf(out, "took %.0f s%s; wrote %s\n", took, took > 1.1 * o->budget_s ? " (over the budget: a warm-up "
+                "and one step of the largest presets exceed their share)" : "", o->out_path);
+    tcb_calibration_free(&cal);
+    tcb_sequence_free(&seq);
+    free(m), free(score_s), free(score_n);
+    return rc;
+}

@@ -1,0 +1,196 @@
+/* Calibrations (harness/calibration.h): a cost at any thread count from
+ * the counts measured (exact, interpolated as a power law, extrapolated
+ * with the last two's scaling clamped to [linear, flat]), the first
+ * calibration that measured a method wins, a cell priced from them, the
+ * file written and read back, and malformed files named. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "harness/calibration.h"
+#include "testutil.h"
+
+static void add(tcb_calibration *c, tcb_cost_kind kind, const char *method, const char *preset, int threads,
+                double s)
+{
+    tcb_cost_entry e = {kind, "", "", threads, 1, s};
+    snprintf(e.method, sizeof e.method, "%s", method);
+    snprintf(e.preset, sizeof e.preset, "%s", preset);
+    tcb_error err = {0};
+    assert_int_equal(tcb_calibration_add(c, &e, &err), TCB_OK);
+}
+
+/* A set of one calibration: m/p steps of 8 s at 1 thread, 5 at 2, 2 at 8. */
+static void one(tcb_calibration_set *s)
+{
+    memset(s, 0, sizeof *s);
+    s->n = 1;
+    snprintf(s->c[0].machine, sizeof s->c[0].machine, "first");
+    s->c[0].n_verts = 1000;
+    add(&s->c[0], TCB_COST_STEP, "m", "p", 8, 2);
+    add(&s->c[0], TCB_COST_STEP, "m", "p", 1, 8);
+    add(&s->c[0], TCB_COST_STEP, "m", "p", 2, 5);
+}
+
+static double price(const tcb_calibration_set *s, int threads, int *extrapolated)
+{
+    tcb_cost_price p;
+    assert_int_equal(tcb_cost_lookup(s, TCB_COST_STEP, "m", "p", threads, &p), 0);
+    *extrapolated = p.extrapolated;
+    return p.seconds;
+}
+
+static void test_thread_scaling(void **state)
+{
+    (void)state;
+    tcb_calibration_set s;
+    one(&s);
+    int ex;
+    assert_near(price(&s, 2, &ex), 5, 1e-12);
+    assert_false(ex);
+    /* between 2 and 8: 5 * (4/2)^b, b = log(2/5)/log(4) */
+    assert_near(price(&s, 4, &ex), 5 * pow(2, log(0.4) / log(4)), 1e-12);
+    assert_false(ex);
+    /* beyond 8: the 2..8 exponent (-0.66) goes on */
+    assert_near(price(&s, 32, &ex), 2 * pow(4, log(0.4) / log(4)), 1e-12);
+    assert_true(ex);
+    /* a measured superlinear scaling is clamped to linear beyond it */
+    add(&s.c[0], TCB_COST_STEP, "m", "p", 16, 0.5);
+    assert_near(price(&s, 64, &ex), 0.5 / 4, 1e-12);
+    assert_true(ex);
+    /* and slower with more threads is clamped to flat */
+    add(&s.c[0], TCB_COST_STEP, "m", "p", 32, 0.9);
+    assert_near(price(&s, 64, &ex), 0.9, 1e-12);
+    /* a count measured again: the later measurement */
+    add(&s.c[0], TCB_COST_STEP, "m", "p", 2, 4);
+    assert_near(price(&s, 2, &ex), 4, 1e-12);
+    tcb_calibration_set_free(&s);
+}
+
+static void test_single_count_and_first_match(void **state)
+{
+    (void)state;
+    tcb_calibration_set s;
+    one(&s);
+    s.n = 2;
+    snprintf(s.c[1].machine, sizeof s.c[1].machine, "second");
+    add(&s.c[1], TCB_COST_STEP, "m", "p", 1, 100);
+    add(&s.c[1], TCB_COST_STEP, "other", "p", 2, 3);
+    tcb_cost_price p;
+    /* m/p is in the first: the second's is not mixed in */
+    assert_int_equal(tcb_cost_lookup(&s, TCB_COST_STEP, "m", "p", 1, &p), 0);
+    assert_near(p.seconds, 8, 1e-12);
+    assert_string_equal(p.from->machine, "first");
+    /* other/p only in the second, at one count: that cost, extrapolated */
+    assert_int_equal(tcb_cost_lookup(&s, TCB_COST_STEP, "other", "p", 16, &p), 0);
+    assert_near(p.seconds, 3, 1e-12);
+    assert_true(p.extrapolated);
+    assert_string_equal(p.from->machine, "second");
+    assert_int_equal(tcb_cost_lookup(&s, TCB_COST_STEP, "m", "q", 1, &p), -1);
+    assert_int_equal(tcb_cost_lookup(&s, TCB_COST_EVAL_PAIR, "m", "p", 1, &p), -1);
+    tcb_calibration_set_free(&s);
+}
+
+static void test_price_cell(void **state)
+{
+    (void)state;
+    tcb_calibration_set s;
+    one(&s);
+    add(&s.c[0], TCB_COST_EVAL_PAIR, "m", "p", 1, 0.25);
+    add(&s.c[0], TCB_COST_SCORE_PAIR, "", "", 1, 0.01);
+    tcb_cost_query q = {10, 2000, 100, 1};
+    tcb_cost_estimate e = {.steps = 1000};
+    snprintf(e.preset, sizeof e.preset, "p");
+    tcb_cost_price_cell(&s, "m", &q, &e);
+    assert_near(e.fit_s, 8000, 1e-9);
+    /* 100 pairs x (0.25 + 0.01 x (2000/1000)^2) */
+    assert_near(e.eval_s, 100 * (0.25 + 0.04), 1e-9);
+    assert_non_null(strstr(e.basis, "1000 steps x 8000.0 ms (1 thread, first)"));
+    /* a method naming no preset keeps its own fit and gets the scoring added */
+    tcb_cost_estimate own = {.fit_s = 3, .eval_s = 1};
+    tcb_cost_price_cell(&s, "x", &q, &own);
+    assert_near(own.fit_s, 3, 0);
+    assert_near(own.eval_s, 1 + 100 * 0.04, 1e-9);
+    /* a preset not measured: unknown, with the command that measures it */
+    tcb_cost_estimate none = {.steps = 5};
+    snprintf(none.preset, sizeof none.preset, "big");
+    tcb_cost_price_cell(&s, "m", &q, &none);
+    assert_true(none.fit_s < 0 && none.eval_s < 0);
+    assert_non_null(strstr(none.basis, "tcbench calibrate --only m --preset big"));
+    tcb_calibration_set_free(&s);
+}
+
+static void test_file_round_trip(void **state)
+{
+    const char *dir = *state;
+    tcb_calibration c = {0};
+    snprintf(c.machine, sizeof c.machine, "CPU, 2 cores");
+    c.machine_json = strdup("{\"summary\": \"CPU, 2 cores\", \"cores\": 2}");
+    c.n_verts = 2688;
+    add(&c, TCB_COST_STEP, "cc", "paper", 2, 2.91234567);
+    add(&c, TCB_COST_SCORE_PAIR, "", "", 1, 0.0101);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/cal.json", dir);
+    tcb_error err = {0};
+    assert_int_equal(tcb_calibration_write(&c, path, &err), TCB_OK);
+    tcb_calibration_free(&c);
+    tcb_calibration_set s;
+    assert_int_equal(tcb_calibration_set_load(dir, &s, &err), TCB_OK); /* no <dir>/calibration.json */
+    int builtin = s.n;
+    tcb_calibration_set_free(&s);
+    char in_run[1024];
+    snprintf(in_run, sizeof in_run, "%s/calibration.json", dir);
+    assert_int_equal(rename(path, in_run), 0);
+    assert_int_equal(tcb_calibration_set_load(dir, &s, &err), TCB_OK);
+    assert_int_equal(s.n, builtin + 1);
+    assert_string_equal(s.c[0].machine, "CPU, 2 cores");
+    assert_int_equal(s.c[0].n_verts, 2688);
+    assert_int_equal(s.c[0].n, 2);
+    assert_near(s.c[0].entries[0].seconds, 2.912, 1e-12); /* 4 significant digits */
+    assert_int_equal(s.c[0].entries[1].kind, TCB_COST_SCORE_PAIR);
+    tcb_calibration_set_free(&s);
+}
+
+static void test_malformed(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *text, *message;
+    } cases[] = {
+        {"[]", "f.json: expected an object"},
+        {"{\"format\": \"x\"}", "f.json: format: expected \"tcbench-calibration 1\""},
+        {"{\"format\": \"tcbench-calibration 1\", \"machine\": {\"summary\": \"m\"}, \"sequence\": {\"vertices\": 9},"
+         " \"costs\": [{\"kind\": \"step\", \"method\": \"a\", \"preset\": \"p\", \"threads\": 1, \"seconds\": -1,"
+         " \"samples\": 1}]}",
+         "f.json: costs[0].seconds"},
+        {"{\"format\": \"tcbench-calibration 1\", \"machine\": {\"summary\": \"m\"}, \"sequence\": {\"vertices\": 9},"
+         " \"costs\": [{\"kind\": \"walk\"}]}",
+         "f.json: costs[0].kind"},
+        {"{\"format\": \"tcbench-calibration 1\", \"machine\": {}, \"sequence\": {\"vertices\": 9}, \"costs\": []}",
+         "f.json: machine.summary"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        tcb_calibration c;
+        tcb_error err = {0};
+        assert_int_equal(tcb_calibration_parse(cases[k].text, "f.json", &c, &err), TCB_ERR_INPUT);
+        if (!strstr(err.msg, cases[k].message)) fail_msg("case %zu: '%s'", k, err.msg);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_thread_scaling),
+        cmocka_unit_test(test_single_count_and_first_match),
+        cmocka_unit_test(test_price_cell),
+        cmocka_unit_test_setup_teardown(test_file_round_trip, tu_setup_tmpdir, tu_teardown_tmpdir),
+        cmocka_unit_test(test_malformed),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
