@@ -84,6 +84,16 @@ static int mark_frames(const tcb_cell_job *job, unsigned char *used)
     return n;
 }
 
+/* A stop request ends the reconstruction metrics between two frames (a
+ * frame of 100 000 samples takes a second or more). */
+static int stopped(const tcb_cell_job *job, int done, int total, tcb_error *herr)
+{
+    if (!job->interrupted || !job->interrupted(job->interrupt_arg)) return 0;
+    tcb_fail(herr, TCB_ERR_INTERRUPTED,
+             "stopped at frame %d of %d of the reconstruction metrics (the fitted model is kept)", done, total);
+    return 1;
+}
+
 void tcb_cell_surface_metrics(const tcb_cell_job *job, void *self, tcb_cell_result *c, tcb_error *merr,
                               tcb_error *herr)
 {
@@ -99,7 +109,8 @@ void tcb_cell_surface_metrics(const tcb_cell_job *job, void *self, tcb_cell_resu
     c->surface = calloc((size_t)n + 1, sizeof *c->surface);
     if (!c->surface) tcb_fail(herr, TCB_ERR_NOMEM, "out of memory for %d frames", n);
     for (int f = 0, k = 0; c->surface && f < job->seq->n_frames && !merr->code && !herr->code; f++) {
-        if (!used[f] || frame_metrics(job, self, f, &s, &c->surface[k], merr, herr)) continue;
+        if (!used[f] || stopped(job, k, n, herr) || frame_metrics(job, self, f, &s, &c->surface[k], merr, herr))
+            continue;
         for (int m = 0; m < TCB_N_RECON; m++) tcb_stat_push(&c->summary.recon[m], c->surface[k].v[m]);
         c->n_surface = ++k;
     }
