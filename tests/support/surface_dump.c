@@ -25,19 +25,9 @@
 #include "tcb/rng.h"
 #include "tcb/sequence.h"
 #include "tcb/synth.h"
+#include "write_bin.h"
 
 #define FRAMES 8
-
-static int write_bin(const char *dir, const char *name, const void *data, size_t bytes, tcb_error *err)
-{
-    char path[TCB_PATH_MAX];
-    int rc = tcb_path_join(path, sizeof path, err, "%s/%s", dir, name);
-    if (rc) return rc;
-    FILE *f = fopen(path, "wb");
-    if (!f || fwrite(data, 1, bytes, f) != bytes || fclose(f))
-        return tcb_fail(err, TCB_ERR_IO, "%s: cannot write", path);
-    return TCB_OK;
-}
 
 /* Frame f's samples, normals and faces, written as <name>.bin, <name>_n.bin
  * and <name>_face.bin; pts and normals stay for the metrics. */
@@ -58,11 +48,11 @@ static int sample_frame(const tcb_sequence *s, int f, int n, uint64_t seed, cons
         rc = tcb_fail(err, TCB_ERR_INTERNAL, "the same stream gave other points");
     size_t bytes = (size_t)n * 3 * sizeof(float);
     snprintf(file, sizeof file, "%s.bin", name);
-    if (!rc) rc = write_bin(dir, file, pts, bytes, err);
+    if (!rc) rc = tcb_test_write_bin(dir, file, pts, bytes, err);
     snprintf(file, sizeof file, "%s_n.bin", name);
-    if (!rc) rc = write_bin(dir, file, normals, bytes, err);
+    if (!rc) rc = tcb_test_write_bin(dir, file, normals, bytes, err);
     snprintf(file, sizeof file, "%s_face.bin", name);
-    if (!rc) rc = write_bin(dir, file, face, (size_t)n * sizeof *face, err);
+    if (!rc) rc = tcb_test_write_bin(dir, file, face, (size_t)n * sizeof *face, err);
     free(check);
     free(face);
     return rc;
@@ -103,8 +93,8 @@ int main(int argc, char **argv)
     if (!rc) rc = sample_frame(&s, a, n, seed, out, "pred", pred, pred_n, &err);
     if (!rc) rc = sample_frame(&s, b, n, seed, out, "gt", gt, gt_n, &err);
     if (!rc) rc = tcb_recon_metrics(pred, pred_n, n, gt, gt_n, n, v, &err);
-    if (!rc) rc = write_bin(out, "verts.bin", s.verts, (size_t)s.n_frames * s.n_verts * 3 * sizeof(float), &err);
-    if (!rc) rc = write_bin(out, "faces.bin", s.faces, (size_t)s.n_faces * 3 * sizeof(int32_t), &err);
+    if (!rc) rc = tcb_test_write_bin(out, "verts.bin", s.verts, (size_t)s.n_frames * s.n_verts * 3 * sizeof(float), &err);
+    if (!rc) rc = tcb_test_write_bin(out, "faces.bin", s.faces, (size_t)s.n_faces * 3 * sizeof(int32_t), &err);
     if (!rc) rc = write_json(out, &s, n, v, &err);
     free(pred), free(pred_n), free(gt), free(gt_n);
     tcb_sequence_free(&s);

@@ -393,20 +393,14 @@ static void test_csv_parses_back(void **state)
     csv_row *rows = read_csv(f, "results.csv", 43, &n);
     /* header + 4 sequences × 3 methods + anim's 3 MEAN rows */
     assert_int_equal(n, 1 + 12 + 3);
-    assert_string_equal(rows[0].field[7], "sl2_x1e3_mean");
-    assert_string_equal(rows[0].field[15], "sl2sq_x1e3_mean");
-    assert_string_equal(rows[0].field[17], "geo_x1e3_mean");
-    assert_string_equal(rows[0].field[21], "geo_unreachable");
-    assert_string_equal(rows[0].field[22], "corr_x1e3_mean");
-    assert_string_equal(rows[0].field[24], "sl2_mark");
-    assert_string_equal(rows[0].field[30], "corr_mark");
-    /* the reconstruction metrics after the marks, then their own marks */
-    assert_string_equal(rows[0].field[31], "cdl2_x1e3_mean");
-    assert_string_equal(rows[0].field[33], "nc_pct_mean");
-    assert_string_equal(rows[0].field[35], "fscore05_pct_mean");
-    assert_string_equal(rows[0].field[37], "fscore1_pct_mean");
-    assert_string_equal(rows[0].field[39], "cdl2_mark");
-    assert_string_equal(rows[0].field[42], "fscore1_mark");
+    /* where the columns are: every addition at the end (Corr before the
+     * marks, the reconstruction metrics and their marks after them) */
+    static const struct { int at; const char *name; } cols[] = {
+        {7, "sl2_x1e3_mean"},   {15, "sl2sq_x1e3_mean"},  {17, "geo_x1e3_mean"},   {21, "geo_unreachable"},
+        {22, "corr_x1e3_mean"}, {24, "sl2_mark"},         {30, "corr_mark"},       {31, "cdl2_x1e3_mean"},
+        {33, "nc_pct_mean"},    {35, "fscore05_pct_mean"}, {37, "fscore1_pct_mean"}, {39, "cdl2_mark"},
+        {42, "fscore1_mark"}};
+    for (size_t k = 0; k < sizeof cols / sizeof *cols; k++) assert_string_equal(rows[0].field[cols[k].at], cols[k].name);
     expect an = expected(1, 0), nn = expected(1, 1);
     const csv_row *r = find_csv(rows, n, "horse", "AN");
     assert_string_equal(r->field[2], "test");
