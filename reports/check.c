@@ -66,9 +66,15 @@ static int check_row(const diff_table *t, const tcb_baseline_row *br, const tcb_
             ok &= check_value(t, row, m, br, cr);
             continue;
         }
-        /* A metric added since the baseline was written: shown, not judged. */
-        char cur[32] = "-";
-        if (cr->has[m]) snprintf(cur, sizeof cur, "%.6f", cr->mean[m]);
+        /* A metric added since the baseline was written: shown, not judged.
+         * When the run has no value for it either (Corr in a pairs-only run),
+         * both sides agree there is nothing to compare. */
+        if (!cr->has[m]) {
+            line(t, row, tcb_rpt_metrics[m].key, "absent", "-", "", "", verdict(1));
+            continue;
+        }
+        char cur[32];
+        snprintf(cur, sizeof cur, "%.6f", cr->mean[m]);
         line(t, row, tcb_rpt_metrics[m].key, "absent", cur, "", "", "unchecked");
     }
     return ok;

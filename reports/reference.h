@@ -75,6 +75,7 @@ typedef struct tcb_ref_cmp_table {
 
 typedef struct tcb_ref_cmp {
     const tcb_reference *ref;
+    const tcb_rpt *run;              /* the run set beside it */
     int n_tables;
     tcb_ref_cmp_table *tables;
 } tcb_ref_cmp;
@@ -101,5 +102,12 @@ tcb_ref_order tcb_ref_order_of(const tcb_ref_group *g, int i, int j, int m, int 
 
 /* ours / paper of metric m's means; NaN when either is missing or the paper's is 0. */
 double tcb_ref_ratio(const tcb_ref_cmp_row *row, int m);
+
+/* Ours is far from the paper's when the ratio lies beyond TCB_REF_FAR
+ * either way (above it, or below its inverse): the reports mark such a
+ * cell, so a reader sees where a reduced preset or a deviation moved a
+ * number, not only where it moved an ordering. */
+#define TCB_REF_FAR 1.5
+int tcb_ref_far(const tcb_ref_cmp_row *row, int m);
 
 #endif

@@ -73,6 +73,7 @@ int tcb_ref_compare(const tcb_reference *ref, const tcb_rpt *r, const char (*ids
 {
     memset(out, 0, sizeof *out);
     out->ref = ref;
+    out->run = r;
     out->tables = calloc((size_t)ref->n_tables, sizeof *out->tables);
     if (!out->tables) return tcb_fail(err, TCB_ERR_NOMEM, "report: out of memory");
     int rc = TCB_OK;
@@ -107,6 +108,12 @@ static int usable(const tcb_ref_cmp_row *row, int m)
 double tcb_ref_ratio(const tcb_ref_cmp_row *row, int m)
 {
     return usable(row, m) && row->paper->mean[m] != 0 ? row->ours->mean[m] / row->paper->mean[m] : NAN;
+}
+
+int tcb_ref_far(const tcb_ref_cmp_row *row, int m)
+{
+    double q = tcb_ref_ratio(row, m);
+    return q > TCB_REF_FAR || q < 1 / TCB_REF_FAR; /* false for NaN */
 }
 
 /* > 0 when row a is better than row b by metric m, in the paper (ours 0) or here (ours 1). */

@@ -27,10 +27,11 @@ static void paper_text(const tcb_ref_row *p, int m, const char *pm, char *out, s
     else snprintf(out, size, "%.*f%s%.*f", d, p->mean[m], pm, d, p->std[m]);
 }
 
-static void ratio_text(const tcb_ref_cmp_row *row, int m, char *out, size_t size)
+/* far_mark follows a ratio beyond TCB_REF_FAR ("†" or LaTeX's dagger). */
+static void ratio_text(const tcb_ref_cmp_row *row, int m, const char *far_mark, char *out, size_t size)
 {
     double q = tcb_ref_ratio(row, m);
-    if (!isnan(q)) snprintf(out, size, "%.2f", q);
+    if (!isnan(q)) snprintf(out, size, "%.2f%s", q, tcb_ref_far(row, m) ? far_mark : "");
     else snprintf(out, size, "-");
 }
 
@@ -39,11 +40,18 @@ typedef struct value_texts {
     char ours[96], paper[96], ratio[32];
 } value_texts;
 
-static void value_texts_of(const tcb_ref_cmp_row *row, int m, const char *pm, value_texts *t)
+/* The marks of Markdown and LaTeX: plus-minus and the far ratio's. */
+typedef struct text_marks {
+    const char *pm, *far;
+} text_marks;
+
+static const text_marks md_marks = {" ± ", " †"}, tex_marks = {" $\\pm$ ", "$^\\dagger$"};
+
+static void value_texts_of(const tcb_ref_cmp_row *row, int m, const text_marks *marks, value_texts *t)
 {
-    ours_text(row, m, pm, t->ours, sizeof t->ours);
-    paper_text(row->paper, m, pm, t->paper, sizeof t->paper);
-    ratio_text(row, m, t->ratio, sizeof t->ratio);
+    ours_text(row, m, marks->pm, t->ours, sizeof t->ours);
+    paper_text(row->paper, m, marks->pm, t->paper, sizeof t->paper);
+    ratio_text(row, m, marks->far, t->ratio, sizeof t->ratio);
 }
 
 static const char *order_name(tcb_ref_order o)
@@ -98,11 +106,13 @@ static void md_group(FILE *f, const tcb_ref_cmp_table *t, const tcb_ref_group *g
         for (int m = 0; m < TCB_N_METRICS; m++) {
             value_texts v;
             if (!t->shown[m]) continue;
-            value_texts_of(row, m, " ± ", &v);
+            value_texts_of(row, m, &md_marks, &v);
             fprintf(f, " %s | %s | %s |", v.ours, v.paper, v.ratio);
         }
         fprintf(f, "\n");
     }
+    fprintf(f, "\n†: ours beyond %.1f× the paper's, either way (a ratio above %.2f or below %.2f).\n",
+            TCB_REF_FAR, TCB_REF_FAR, 1 / TCB_REF_FAR);
     fprintf(f, "\nThe order of the rows, here and in the paper (a flip is significant when our difference "
                "is: Holm-adjusted Wilcoxon p < 0.05 and its 95 %% interval excluding 0, comparisons.md):\n\n");
     for (int m = 0; m < TCB_N_METRICS; m++)
@@ -111,7 +121,8 @@ static void md_group(FILE *f, const tcb_ref_cmp_table *t, const tcb_ref_group *g
 
 static void write_md(FILE *f, const tcb_ref_cmp *c)
 {
-    fprintf(f, "# Beside the paper: %s\n\n%s\n", c->ref->name, c->ref->paper);
+    fprintf(f, "# Beside the paper: %s\n\n%s\n\n", c->ref->name, c->ref->paper);
+    tcb_rpt_write_presets_md(f, c->run);
     for (int k = 0; k < c->n_tables; k++) {
         const tcb_ref_cmp_table *t = &c->tables[k];
         fprintf(f, "\n## %s\n", t->table->title);
@@ -133,7 +144,8 @@ static void tex_group(FILE *f, const tcb_ref_cmp_table *t, const tcb_ref_group *
     tcb_rpt_tex_escaped(f, g->dataset);
     fputs("/", f);
     tcb_rpt_tex_escaped(f, g->sequence);
-    fputs(". Each cell: ours / paper (ours$/$paper).}\n\\begin{tabular}{l", f);
+    fprintf(f, ". Each cell: ours / paper (ours$/$paper); $^\\dagger$: ours beyond %.1f$\\times$ the "
+               "paper's, either way.}\n\\begin{tabular}{l", TCB_REF_FAR);
     for (int k = 0; k < cols; k++) fputs("c", f);
     fputs("}\n\\toprule\nRow", f);
     for (int m = 0; m < TCB_N_METRICS; m++)
@@ -145,7 +157,7 @@ static void tex_group(FILE *f, const tcb_ref_cmp_table *t, const tcb_ref_group *
         for (int m = 0; m < TCB_N_METRICS; m++) {
             value_texts v;
             if (!t->shown[m]) continue;
-            value_texts_of(row, m, " $\\pm$ ", &v);
+            value_texts_of(row, m, &tex_marks, &v);
             fprintf(f, " & %s / %s (%s)", v.ours, v.paper, v.ratio);
         }
         fputs(" \\\\\n", f);
@@ -170,7 +182,8 @@ static void csv_value(FILE *f, int has, double v)
 
 static void write_csv(FILE *f, const tcb_ref_cmp *c)
 {
-    fputs("table,dataset,sequence,paper_row,method,metric,ours_mean,ours_std,paper_mean,paper_std,ratio,status\n", f);
+    fputs("table,dataset,sequence,paper_row,method,metric,ours_mean,ours_std,paper_mean,paper_std,ratio,status,"
+          "beyond_1_5x\n", f);
     for (int k = 0; k < c->n_tables; k++)
         for (int g = 0; g < c->tables[k].n_groups; g++) {
             const tcb_ref_group *gr = &c->tables[k].groups[g];
@@ -186,7 +199,7 @@ static void write_csv(FILE *f, const tcb_ref_cmp *c)
                     csv_value(f, row->paper->has[m], row->paper->mean[m]);
                     csv_value(f, row->paper->has_std[m], row->paper->std[m]);
                     csv_value(f, !isnan(tcb_ref_ratio(row, m)), tcb_ref_ratio(row, m));
-                    fprintf(f, ",%s\n", row->ours ? row->ours->status : "not run");
+                    fprintf(f, ",%s,%d\n", row->ours ? row->ours->status : "not run", tcb_ref_far(row, m));
                 }
         }
 }

@@ -124,22 +124,41 @@ static void cells_of(const tcb_cell_result *cells, int n, const char *name, int 
     while (*end < n && !strcmp(cells[*end].method, name)) (*end)++;
 }
 
+/* Comparison x of the block; cells that cannot be paired are said in its
+ * note (the matrix shows it), not an error. */
+static int compare_pair(const tcb_rpt_block *b, tcb_rpt_cmp *x, const tcb_cell_result *cells, int n,
+                        int resamples, tcb_error *err)
+{
+    int fa, ea, fb, eb;
+    cells_of(cells, n, b->rows[x->a].method, &fa, &ea);
+    cells_of(cells, n, b->rows[x->b].method, &fb, &eb);
+    int rc = tcb_compare_cells(cells + fa, ea - fa, cells + fb, eb - fb, resamples, &x->c, err);
+    if (rc != TCB_ERR_INPUT) return rc;
+    snprintf(x->note, sizeof x->note, "%s", err->msg);
+    return TCB_OK;
+}
+
+/* The comparisons run in parallel: each draws its resamples afresh from
+ * the comparison seed's streams (one per metric, reports/compare.c), so
+ * the order they run in changes no bit of the report. The first failure in
+ * comparison order is the one reported. */
 int tcb_rpt_compare_block(tcb_rpt_block *b, const tcb_cell_result *cells, int n, int resamples,
                           tcb_error *err)
 {
     int rc = alloc_pairs(b, err);
-    for (int k = 0; k < b->n_cmp && !rc; k++) {
-        tcb_rpt_cmp *x = &b->cmp[k];
-        if (x->note[0]) continue;
-        int fa, ea, fb, eb;
-        cells_of(cells, n, b->rows[x->a].method, &fa, &ea);
-        cells_of(cells, n, b->rows[x->b].method, &fb, &eb);
-        rc = tcb_compare_cells(cells + fa, ea - fa, cells + fb, eb - fb, resamples, &x->c, err);
-        if (rc == TCB_ERR_INPUT) { /* cells that cannot be paired: said in the matrix, not fatal */
-            snprintf(x->note, sizeof x->note, "%s", err->msg);
-            rc = TCB_OK;
-        }
+    if (rc) return rc;
+    tcb_error *errs = calloc((size_t)(b->n_cmp > 0 ? b->n_cmp : 1), sizeof *errs);
+    int *codes = calloc((size_t)(b->n_cmp > 0 ? b->n_cmp : 1), sizeof *codes);
+    if (!errs || !codes) {
+        free(errs), free(codes);
+        return tcb_fail(err, TCB_ERR_NOMEM, "report: out of memory");
     }
+#pragma omp parallel for schedule(dynamic)
+    for (int k = 0; k < b->n_cmp; k++)
+        if (!b->cmp[k].note[0]) codes[k] = compare_pair(b, &b->cmp[k], cells, n, resamples, &errs[k]);
+    for (int k = 0; k < b->n_cmp && !rc; k++)
+        if (codes[k]) rc = codes[k], *err = errs[k];
+    free(errs), free(codes);
     return rc ? rc : adjust_and_mark(b, err);
 }
 

@@ -224,5 +224,6 @@ void tcb_rpt_write_md(FILE *f, const tcb_rpt *r)
                "clip protocol's tracking error, over clips. CD-L2 ×1e3, NC %% and F-score %% at 0.5 %% and "
                "1 %% (F@0.5%%, F@1%%): the reconstruction metrics of DynoSurf's evaluation, over the "
                "evaluated frames; \"-\" there: the method gives no surface (or its cells predate them).\n\n");
+    tcb_rpt_write_presets_md(f, r);
     for (int k = 0; k < r->n_datasets; k++) write_dataset(f, r, &r->datasets[k]);
 }

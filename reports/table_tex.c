@@ -74,6 +74,11 @@ static void write_dataset(FILE *f, const tcb_rpt *r, const tcb_rpt_dataset *d)
 
 void tcb_rpt_write_tex(FILE *f, const tcb_rpt *r)
 {
-    fputs("% tcbench results; needs \\usepackage{booktabs}.\n\n", f);
+    char presets[TCB_RPT_PRESETS_MAX];
+    int not_paper = tcb_rpt_presets(r, presets);
+    fputs("% tcbench results; needs \\usepackage{booktabs}.\n", f);
+    if (presets[0])
+        fprintf(f, "%% presets: %s%s\n", presets, not_paper ? " (not the paper's training)" : "");
+    fputs("\n", f);
     for (int k = 0; k < r->n_datasets; k++) write_dataset(f, r, &r->datasets[k]);
 }

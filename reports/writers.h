@@ -27,6 +27,14 @@ void tcb_rpt_write_cmp_md(FILE *f, const tcb_rpt *r);
 void tcb_rpt_write_cmp_tex(FILE *f, const tcb_rpt *r);
 void tcb_rpt_write_cmp_csv(FILE *f, const tcb_rpt *r);
 
+/* The presets the run's rows name, "atlasnet `cpu`, mca `cpu`" (each
+ * (row, preset) once); returns 1 when one of them is not `paper`. And the
+ * sentence above a Markdown report's tables that says so (nothing when no
+ * row names a preset). (reports/presets.c) */
+#define TCB_RPT_PRESETS_MAX 1024
+int tcb_rpt_presets(const tcb_rpt *r, char list[TCB_RPT_PRESETS_MAX]);
+void tcb_rpt_write_presets_md(FILE *f, const tcb_rpt *r);
+
 /* One PNG per block, published atomically at `path`: the PCK curves, the
  * geodesic PCK curves (reports/plot_pck.c) and m_sL2 by frame distance
  * (reports/plot_gap.c). */

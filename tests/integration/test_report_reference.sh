@@ -36,8 +36,11 @@ json.dump({"format": "tcbench-reference/1", "name": "toy", "paper": "A toy paper
 PY
 expect 0 "## Table B: toy" "$TCBENCH" report run --reference toy.json
 grep -qF "Table A" out.txt && { echo "FAIL: table A is not the config's"; cat out.txt; exit 1; }
-grep -qE "^\| row nearest \| nearest \| [0-9.]+ ± [0-9.]+ \| [0-9.]+ \| 2\.00 \|" out.txt || { echo "FAIL: nearest row"; cat out.txt; exit 1; }
-grep -qE "^\| row oracle \| oracle \| 0\.00 ± 0\.00 \| [0-9.]+ ± 2\.00 \| 0\.00 \|" out.txt || { echo "FAIL: oracle row"; cat out.txt; exit 1; }
+# Ratios beyond 1.5x either way are marked: nearest's 2.00, the oracle's 0.00.
+grep -qE "^\| row nearest \| nearest \| [0-9.]+ ± [0-9.]+ \| [0-9.]+ \| 2\.00 † \|" out.txt || { echo "FAIL: nearest row"; cat out.txt; exit 1; }
+grep -qE "^\| row oracle \| oracle \| 0\.00 ± 0\.00 \| [0-9.]+ ± 2\.00 \| 0\.00 † \|" out.txt || { echo "FAIL: oracle row"; cat out.txt; exit 1; }
+grep -qF "†: ours beyond 1.5× the paper's" out.txt || { echo "FAIL: no legend of †"; cat out.txt; exit 1; }
+grep -qF "Presets" out.txt && { echo "FAIL: no row names a preset"; cat out.txt; exit 1; }
 grep -qF "| row absent | absent | not run |" out.txt || { echo "FAIL: absent row"; cat out.txt; exit 1; }
 # 30 pairs: the oracle's lead is significant, so the paper's order flips for real.
 grep -qF -- "- m_sL2 ↓: 1 ordering: agrees 0, flips (significant) 1, flips (within noise) 0" out.txt &&
@@ -51,8 +54,44 @@ import csv
 rows = list(csv.DictReader(open("run/report/reference_toy.csv")))
 near = [r for r in rows if r["method"] == "nearest" and r["metric"] == "sl2"][0]
 assert abs(float(near["ratio"]) - 2) < 1e-5 and near["paper_std"] == "" and near["status"] == "ok", near
+assert near["beyond_1_5x"] == "1", near
 assert [r["status"] for r in rows if r["method"] == "absent"] == ["not run", "not run"]
 PY
+
+# A ratio within 1.5x is not marked: the paper made 1.4 times our nearest.
+/usr/bin/python3 - <<'PY'
+import json
+ref = json.load(open("toy.json"))
+near = ref["tables"][1]["rows"][1]
+near["sl2"][0] *= 2 / 1.4
+json.dump(ref, open("toy14.json", "w"))
+PY
+expect 0 "## Table B: toy" "$TCBENCH" report run --reference toy14.json --out near14
+grep -qE "^\| row nearest \| nearest \| [0-9.]+ ± [0-9.]+ \| [0-9.]+ \| 1\.40 \|" out.txt || { echo "FAIL: 1.40 marked"; cat out.txt; exit 1; }
+/usr/bin/python3 - <<'PY'
+import csv
+far = {r["method"]: r["beyond_1_5x"] for r in csv.DictReader(open("near14/reference_toy.csv")) if r["metric"] == "sl2"}
+assert far == {"oracle": "1", "nearest": "0", "absent": "0"}, far
+PY
+
+# A run whose cells name a preset other than `paper` says so above its
+# tables, in the reference report, tables.md and tables.tex.
+cp -r run runp
+/usr/bin/python3 - <<'PY'
+import json
+p = "runp/cells/synth/quadruped_walk/nearest/seed_0.json"
+c = json.load(open(p)); c["params"] = {"preset": "cpu"}; json.dump(c, open(p, "w"))
+PY
+expect 0 "**Presets**: nearest \`cpu\`. These are not the paper's training" "$TCBENCH" report runp --reference toy.json
+"$TCBENCH" report runp --quiet
+grep -qF "**Presets**: nearest \`cpu\`. These are not the paper's training" runp/report/tables.md || { echo "FAIL: tables.md"; exit 1; }
+grep -qF "% presets: nearest \`cpu\` (not the paper's training)" runp/report/tables.tex || { echo "FAIL: tables.tex"; exit 1; }
+/usr/bin/python3 - <<'PY'
+import json
+p = "runp/cells/synth/quadruped_walk/nearest/seed_0.json"
+c = json.load(open(p)); c["params"] = {"preset": "paper"}; json.dump(c, open(p, "w"))
+PY
+expect 0 "**Presets**: nearest \`paper\`: the paper's training." "$TCBENCH" report runp --reference toy.json
 
 # On 3 pairs no difference can be significant (Wilcoxon's smallest p with
 # n = 3 is 0.25): the same flip is within the noise.
