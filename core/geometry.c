@@ -105,6 +105,20 @@ static int cdf_search(const double *cdf, int nf, double r)
 int tcb_sample_surface(const float *verts, const int32_t *faces, int nf, int n,
                        tcb_rng *rng, float *out, tcb_error *err)
 {
+    return tcb_sample_surface_faces(verts, faces, nf, n, rng, out, NULL, err);
+}
+
+void tcb_face_normal(const float *verts, const int32_t *face, float out[3])
+{
+    double n[3];
+    tri_cross(verts + 3 * (size_t)face[0], verts + 3 * (size_t)face[1], verts + 3 * (size_t)face[2], n);
+    double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (int d = 0; d < 3; d++) out[d] = len > 0.0 ? (float)(n[d] / len) : 0.0f;
+}
+
+int tcb_sample_surface_faces(const float *verts, const int32_t *faces, int nf, int n,
+                             tcb_rng *rng, float *out, int32_t *face_of, tcb_error *err)
+{
     if (n < 0 || nf <= 0)
         return tcb_fail(err, TCB_ERR_INPUT, "cannot sample %d points from %d faces", n, nf);
     double *cdf = malloc((size_t)nf * sizeof *cdf); /* [nf] running area */
@@ -122,7 +136,9 @@ int tcb_sample_surface(const float *verts, const int32_t *faces, int nf, int n,
         /* u·total can round up to total; keeping r strictly below it means
          * the search always finds a face with cdf > r, i.e. positive area. */
         double r = fmin(tcb_rng_uniform(rng) * total, nextafter(total, 0.0));
-        const int32_t *f = faces + 3 * (size_t)cdf_search(cdf, nf, r);
+        int face = cdf_search(cdf, nf, r);
+        if (face_of) face_of[s] = face;
+        const int32_t *f = faces + 3 * (size_t)face;
         /* PyTorch3D's barycentrics: uniform over the triangle. */
         double su = sqrt(tcb_rng_uniform(rng)), v = tcb_rng_uniform(rng);
         double w0 = 1.0 - su, w1 = su * (1.0 - v), w2 = su * v;

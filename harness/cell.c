@@ -96,7 +96,7 @@ static void save_checkpoint(const tcb_cell_job *job, void *self, double fit_s)
 
 /* A method that returned an error without describing it still fails the
  * cell with a readable message. */
-static void ensure_error(tcb_error *merr, int rc)
+void tcb_cell_ensure_error(tcb_error *merr, int rc)
 {
     if (merr->code == TCB_OK)
         merr->code = rc > TCB_OK && rc <= TCB_ERR_INTERNAL ? (tcb_status)rc : TCB_ERR_INTERNAL;
@@ -110,7 +110,7 @@ static int create_method(const tcb_cell_job *job, void **self, tcb_error *merr)
     *self = NULL;
     int rc = job->ops->create(job->method->params_json, self, merr);
     if (!rc) return TCB_OK;
-    ensure_error(merr, rc);
+    tcb_cell_ensure_error(merr, rc);
     tcb_error_prefix(merr, "create: ");
     return rc;
 }
@@ -159,7 +159,7 @@ static int prepare_method(const tcb_cell_job *job, void **self, double *fit_s, t
     double spent = earlier + tcb_now_seconds() - t0;
     if (fit_s) *fit_s = spent;
     if (rc) {
-        ensure_error(merr, rc);
+        tcb_cell_ensure_error(merr, rc);
         tcb_error_prefix(merr, "fit: ");
         ops->destroy(*self);
         return rc;
@@ -176,7 +176,7 @@ int tcb_cell_prepare_pairs(const tcb_cell_job *job, void *self, const int *pairs
     tcb_fit_ctx ctx = fit_ctx(job, NULL);
     int rc = ops->prepare_pairs(self, job->seq, pairs, first, n, &ctx, merr);
     if (!rc) return TCB_OK;
-    ensure_error(merr, rc);
+    tcb_cell_ensure_error(merr, rc);
     tcb_error_prefix(merr, "prepare_pairs %d-%d: ", first, first + n - 1);
     return rc;
 }
@@ -206,7 +206,7 @@ static void reconstruction_cd(const tcb_cell_job *job, void *self, int i, int j,
         return;
     }
     if (rc) {
-        ensure_error(merr, rc);
+        tcb_cell_ensure_error(merr, rc);
         tcb_error_prefix(merr, "reconstruct frame %d (pair %d->%d): ", frame, i, j);
     } else if (!pts || n <= 0)
         tcb_fail(merr, TCB_ERR_INTERNAL, "reconstruct frame %d (pair %d->%d): returned no points",
@@ -232,7 +232,7 @@ static int transfer_pair(const tcb_cell_job *job, void *self, int i, int j, int 
     int nv = seq->n_verts;
     int rc = job->ops->transfer(self, seq, i, j, tcb_seq_frame(seq, i), nv, moved, rng, merr);
     if (rc) {
-        ensure_error(merr, rc);
+        tcb_cell_ensure_error(merr, rc);
         tcb_error_prefix(merr, "transfer %d->%d (pair %d): ", i, j, k);
         return rc;
     }
@@ -372,6 +372,7 @@ static void evaluate(const tcb_cell_job *job, void *self, tcb_cell_result *c, tc
         }
         c->n_pairs = split->n_pairs;
         if (job->clips && !merr->code && !herr->code) evaluate_clips(job, self, &b, c, label, total, merr, herr);
+        if (!merr->code && !herr->code) tcb_cell_surface_metrics(job, self, c, merr, herr);
     }
     eval_bufs_free(&b);
 }
@@ -383,10 +384,13 @@ static void record_failure(tcb_cell_result *c, const tcb_error *merr)
     snprintf(c->message, sizeof c->message, "%s", merr->msg);
     free(c->pairs);
     free(c->clips);
+    free(c->surface);
     c->pairs = NULL;
     c->clips = NULL;
+    c->surface = NULL;
     c->n_pairs = 0;
     c->n_clips = 0;
+    c->n_surface = 0;
     tcb_summary_init(&c->summary);
 }
 
@@ -487,7 +491,7 @@ int tcb_cell_use_method(const tcb_cell_job *job, tcb_method_use use, void *ctx, 
     int rc = prepare_method(job, &self, NULL, &merr);
     if (!rc) {
         rc = use(ctx, self, &merr);
-        if (rc) ensure_error(&merr, rc);
+        if (rc) tcb_cell_ensure_error(&merr, rc);
         job->ops->destroy(self);
     }
     restore_threads(prev);

@@ -21,7 +21,7 @@ static const char *const top_keys[] = {"name", "output", "splits_dir", "cache_di
                                        "reference", NULL};
 static const char *const reference_keys[] = {"source", "tables", NULL};
 static const char *const eval_keys[] = {"pairs", "split_seed", "pool_size", "pool_seed",
-                                        "input_points", "protocol", "clips", NULL};
+                                        "input_points", "protocol", "clips", "surface_samples", NULL};
 /* Indexed by the bit's position: TCB_PROTOCOL_PAIRS, TCB_PROTOCOL_CLIPS. */
 const char *const tcb_config_protocol_names[] = {"pairs", "clips", NULL};
 static const char *const synthetic_keys[] = {"name", "source", "seed", "frames", "normalization",
@@ -452,7 +452,7 @@ static int parse_evaluation(const cJSON *root, const char *origin, tcb_config *c
     const cJSON *ev = cJSON_GetObjectItemCaseSensitive(root, "evaluation");
     cJSON *empty = NULL;
     if (!ev) ev = empty = cJSON_CreateObject();
-    long long pairs, split_seed, pool, pool_seed, input, clips;
+    long long pairs, split_seed, pool, pool_seed, input, clips, surface;
     int rc = tcb_json_expect_keys(ev, w, eval_keys, err);
     if (!rc) rc = parse_protocol(ev, w, c, err);
     if (!rc && cJSON_HasObjectItem(ev, "clips") && !(c->protocols & TCB_PROTOCOL_CLIPS))
@@ -467,6 +467,8 @@ static int parse_evaluation(const cJSON *root, const char *origin, tcb_config *c
     if (!rc)
         rc = tcb_json_int(ev, "input_points", w, 0, TCB_DEFAULT_INPUT_POINTS, 1, 10000000,
                           &input, err);
+    if (!rc)
+        rc = tcb_json_int(ev, "surface_samples", w, 0, TCB_DEFAULT_SURFACE_SAMPLES, 1, 10000000, &surface, err);
     cJSON_Delete(empty);
     if (rc) return rc;
     c->eval_pairs = (int)pairs;
@@ -475,6 +477,7 @@ static int parse_evaluation(const cJSON *root, const char *origin, tcb_config *c
     c->pool_size = (int)pool;
     c->pool_seed = (uint64_t)pool_seed;
     c->input_points = (int)input;
+    c->surface_samples = (int)surface;
     return TCB_OK;
 }
 

@@ -13,6 +13,9 @@ static cJSON *dump_evaluation(const tcb_config *c)
     cJSON_AddNumberToObject(ev, "pool_size", c->pool_size);
     cJSON_AddNumberToObject(ev, "pool_seed", (double)c->pool_seed);
     cJSON_AddNumberToObject(ev, "input_points", c->input_points);
+    /* Only when not the default, as the protocol below. */
+    if (c->surface_samples != TCB_DEFAULT_SURFACE_SAMPLES)
+        cJSON_AddNumberToObject(ev, "surface_samples", c->surface_samples);
     /* Only when not the default, so that the record of a run directory made
      * before the clip protocol still reads as the same settings. */
     if (c->protocols == TCB_PROTOCOL_PAIRS) return ev;

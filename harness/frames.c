@@ -50,12 +50,10 @@ static int spaced_frames(const tcb_frames_opts *o, const tcb_sequence *seq, int 
     return TCB_OK;
 }
 
-static int has_surface(const tcb_method_ops *ops) { return ops->abi_version >= 3 && ops->surface; }
-
 static int texture_wanted(const tcb_frames_opts *o, const tcb_cell_target *t, int *texture, tcb_error *err)
 {
-    *texture = o->style == TCB_FRAMES_TEXTURE || (o->style == TCB_FRAMES_AUTO && has_surface(t->ops));
-    if (*texture && !has_surface(t->ops))
+    *texture = o->style == TCB_FRAMES_TEXTURE || (o->style == TCB_FRAMES_AUTO && tcb_method_has_surface(t->ops));
+    if (*texture && !tcb_method_has_surface(t->ops))
         return tcb_fail(err, TCB_ERR_INPUT,
                         "--style texture: method '%s' (%s) has no textured surface (no `surface` in its table); "
                         "--style transfer draws its correspondences",

@@ -19,45 +19,6 @@ typedef struct surfaces {
     tcb_uv_mesh *mesh; /* [f->n] */
 } surfaces;
 
-static int faces_valid(const tcb_uv_mesh *m)
-{
-    for (size_t k = 0; k < 3 * (size_t)m->n_faces; k++)
-        if (m->faces[k] < 0 || m->faces[k] >= m->n_verts) return 0;
-    for (size_t t = 0; t < (size_t)m->n_faces; t++) {
-        const int32_t *v = m->faces + 3 * t;
-        if (m->chart[v[0]] != m->chart[v[1]] || m->chart[v[0]] != m->chart[v[2]]) return 0;
-    }
-    return 1;
-}
-
-static int charts_valid(const tcb_uv_mesh *m)
-{
-    for (size_t k = 0; k < (size_t)m->n_verts; k++) {
-        float u = m->uv[2 * k], v = m->uv[2 * k + 1];
-        if (m->chart[k] < 0 || m->chart[k] >= m->n_charts || !(u >= 0 && u <= 1 && v >= 0 && v <= 1)) return 0;
-    }
-    return 1;
-}
-
-/* What tcb/method.h promises of a surface, checked before anything uses it. */
-static int check_mesh(const tcb_uv_mesh *m, int frame, tcb_error *merr)
-{
-    if (m->n_verts < 3 || m->n_faces < 1 || m->n_charts < 1 || m->n_charts > MAX_CHARTS || !m->verts ||
-        !m->uv || !m->chart || !m->faces)
-        return tcb_fail(merr, TCB_ERR_INTERNAL,
-                        "surface of frame %d: %d vertices, %d faces, %d charts (1 to %d) or a NULL array", frame,
-                        m->n_verts, m->n_faces, m->n_charts, MAX_CHARTS);
-    if (!tcb_all_finite(m->verts, 3 * (size_t)m->n_verts))
-        return tcb_fail(merr, TCB_ERR_NUMERIC, "surface of frame %d: a non-finite vertex", frame);
-    if (!charts_valid(m))
-        return tcb_fail(merr, TCB_ERR_INTERNAL, "surface of frame %d: a chart id or (u, v) outside its range",
-                        frame);
-    if (!faces_valid(m))
-        return tcb_fail(merr, TCB_ERR_INTERNAL,
-                        "surface of frame %d: a face names a vertex out of range or spans two charts", frame);
-    return TCB_OK;
-}
-
 /* One texture and one face colouring serve all frames only if they agree. */
 static int same_topology(const tcb_uv_mesh *a, const tcb_uv_mesh *b, int fa, int fb, tcb_error *merr)
 {
@@ -83,7 +44,7 @@ static int decode_frames(void *ctx, void *self, tcb_error *merr)
             tcb_error_prefix(merr, "surface of frame %d: ", f->frames[k]);
             return rc;
         }
-        if ((rc = check_mesh(&s->mesh[k], f->frames[k], merr))) return rc;
+        if ((rc = tcb_surface_check(&s->mesh[k], f->frames[k], MAX_CHARTS, merr))) return rc;
         if (k && (rc = same_topology(&s->mesh[0], &s->mesh[k], f->frames[0], f->frames[k], merr))) return rc;
     }
     return TCB_OK;

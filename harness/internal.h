@@ -214,7 +214,32 @@ typedef struct tcb_cell_job {
      * it). Without the pairs protocol, split->n_pairs is 0. */
     const tcb_split *clips;
     const char *clips_path;
+    /* Samples per mesh of the reconstruction metrics ("evaluation.
+     * surface_samples"); 0: not computed (a job that does not set it). */
+    int surface_samples;
 } tcb_cell_job;
+
+/* The method of ops gives a surface per frame (tcb_method_ops.surface). */
+static inline int tcb_method_has_surface(const tcb_method_ops *ops)
+{
+    return ops->abi_version >= 3 && ops->surface;
+}
+
+/* A method's failure rc that left merr empty described anyway, so the cell
+ * fails with a readable message (harness/cell.c). */
+void tcb_cell_ensure_error(tcb_error *merr, int rc);
+
+/* What tcb/method.h promises of a method's surface of `frame` (at most
+ * max_charts charts), checked before anything uses it; a failure lands in
+ * merr (harness/surface_check.c). */
+int tcb_surface_check(const tcb_uv_mesh *m, int frame, int max_charts, tcb_error *merr);
+
+/* The reconstruction metrics of the cell's evaluated frames (every frame of
+ * the split's pairs and of the clips, once each, ascending) into
+ * c->surface and c->summary.recon, when the method gives surfaces and
+ * job->surface_samples > 0 (harness/cell_surface.c). */
+void tcb_cell_surface_metrics(const tcb_cell_job *job, void *self, tcb_cell_result *c, tcb_error *merr,
+                              tcb_error *herr);
 
 /* The record of a cell's model checkpoint (<checkpoint>.fit.json): the
  * cell it was made for, the sequence's fingerprint, the file's size and

@@ -127,6 +127,27 @@ static void add_summary(builder *b, cJSON *root, const tcb_summary *s)
         append(b, geo_pck, num_or_null(s->geo_pck[k]));
     add_num(b, o, "geo_unreachable", s->geo_unreachable);
     if (s->corr.n > 0) add_stat(b, o, "corr", &s->corr);
+    for (int m = 0; m < TCB_N_RECON; m++)
+        if (s->recon[m].n > 0) add_stat(b, o, tcb_recon_names[m], &s->recon[m]);
+}
+
+/* The reconstruction metrics per evaluated frame, when the cell has them. */
+static void add_surface(builder *b, cJSON *root, const tcb_cell_result *c)
+{
+    if (c->n_surface == 0) return;
+    cJSON *o = add(b, root, "surface", cJSON_CreateObject());
+    if (!o) return;
+    add_num(b, o, "samples", c->surface_samples);
+    cJSON *cols = add(b, o, "columns", cJSON_CreateArray());
+    append(b, cols, cJSON_CreateString("frame"));
+    for (int m = 0; cols && m < TCB_N_RECON; m++) append(b, cols, cJSON_CreateString(tcb_recon_names[m]));
+    cJSON *rows = add(b, o, "rows", cJSON_CreateArray());
+    for (int k = 0; rows && k < c->n_surface && b->ok; k++) {
+        cJSON *row = cJSON_CreateArray();
+        if (!append(b, rows, row)) return;
+        append(b, row, num_or_null(c->surface[k].frame));
+        for (int m = 0; m < TCB_N_RECON; m++) append(b, row, num_or_null(c->surface[k].v[m]));
+    }
 }
 
 /* The clip protocol's split and rows, when the cell scored clips. */
@@ -195,6 +216,9 @@ static int check_for_save(const char *path, const tcb_cell_result *c, tcb_error 
     if (c->n_clips < 0 || (c->n_clips > 0 && !c->clips) || (double)c->clips_seed > TCB_JSON_INT_MAX)
         return tcb_fail(err, TCB_ERR_INTERNAL, "%s: %d clips without records, or a clip seed past 2^53", path,
                         c->n_clips);
+    if (c->n_surface < 0 || (c->n_surface > 0 && (!c->surface || c->surface_samples < 1)))
+        return tcb_fail(err, TCB_ERR_INTERNAL, "%s: %d surface frames without records or samples", path,
+                        c->n_surface);
     if ((double)c->split_seed > TCB_JSON_INT_MAX)
         return tcb_fail(err, TCB_ERR_INPUT, "%s: split seed %llu exceeds 2^53", path,
                         c->split_seed);
@@ -259,6 +283,7 @@ cJSON *tcb_cell_to_json(const char *path, const tcb_cell_result *c, tcb_error *e
     add_summary(&b, root, &c->summary);
     add_pairs(&b, root, c);
     add_clips(&b, root, c);
+    add_surface(&b, root, c);
     if (!b.ok) {
         cJSON_Delete(root);
         tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", path);
@@ -284,9 +309,12 @@ void tcb_cell_free(tcb_cell_result *c)
     free(c->params_json);
     free(c->pairs);
     free(c->clips);
+    free(c->surface);
     c->params_json = NULL;
     c->pairs = NULL;
     c->clips = NULL;
+    c->surface = NULL;
     c->n_pairs = 0;
     c->n_clips = 0;
+    c->n_surface = 0;
 }

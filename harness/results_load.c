@@ -16,18 +16,21 @@ static const char *const TOP_KEYS[] = {
     "format",       "dataset",         "sequence", "role",        "method",
     "method_impl",  "params",          "seed",     "status",      "message",
     "git_revision", "tcbench_version", "timings",  "peak_rss_kb", "split",
-    "summary",      "pair_columns",    "pairs",    "clips",       NULL};
+    "summary",      "pair_columns",    "pairs",    "clips",       "surface", NULL};
 static const char *const TIMING_KEYS[] = {"load_s", "fit_s", "eval_s", NULL};
 static const char *const SPLIT_KEYS[] = {"path", "seed", "n_pairs", NULL};
 static const char *const SUMMARY_KEYS[] = {"n_pairs", "sl2",     "sl2sq",   "rank",
                                            "auc",     "cd",      "pck",     "geo",
-                                           "geo_auc", "geo_pck", "geo_unreachable", "corr", NULL};
+                                           "geo_auc", "geo_pck", "geo_unreachable", "corr",
+                                           "cdl2",    "nc",      "fscore05", "fscore1", NULL};
 /* The summary's geodesic keys: all or none (none in a cell written before
  * the geodesic error). */
 static const char *const GEO_KEYS[] = {"geo", "geo_auc", "geo_pck", "geo_unreachable", NULL};
 static const char *const STAT_KEYS[] = {"n", "mean", "m2", NULL};
 /* The clip protocol's (absent in a cell without clips). */
 static const char *const CLIPS_KEYS[] = {"path", "seed", "clip_frames", "n_clips", "columns", "rows", NULL};
+/* The reconstruction metrics' (absent in a cell without them). */
+static const char *const SURFACE_KEYS[] = {"samples", "columns", "rows", NULL};
 
 /* Key paths for messages ("file: summary.sl2.mean"); a path too long for
  * the buffer is cut, which only shortens a message. */
@@ -157,6 +160,10 @@ static int load_summary(const cJSON *root, const char *where, tcb_summary *s, tc
         return rc;
     if ((rc = load_curve(o, "pck", sub, TCB_PCK_STEPS, s->pck, err))) return rc;
     if (cJSON_HasObjectItem(o, "corr") && (rc = load_stat(o, "corr", sub, &s->corr, err))) return rc;
+    for (int m = 0; m < TCB_N_RECON; m++)
+        if (cJSON_HasObjectItem(o, tcb_recon_names[m]) &&
+            (rc = load_stat(o, tcb_recon_names[m], sub, &s->recon[m], err)))
+            return rc;
     return load_summary_geodesic(o, sub, s, err);
 }
 
@@ -304,6 +311,56 @@ static int load_clips(const cJSON *root, const char *where, tcb_cell_result *c, 
     return rc;
 }
 
+/* The "surface" columns: "frame", then tcb_recon_names in order. */
+static int surface_columns_ok(const cJSON *cols)
+{
+    int k = 0, ok = cJSON_IsArray(cols) && cJSON_GetArraySize(cols) == TCB_N_RECON + 1;
+    for (const cJSON *e = ok ? cols->child : NULL; e; e = e->next, k++)
+        ok = ok && cJSON_IsString(e) && !strcmp(e->valuestring, k ? tcb_recon_names[k - 1] : "frame");
+    return ok;
+}
+
+/* A surface row: [frame, cdl2, nc, fscore05, fscore1]. */
+static int load_surface_row(const cJSON *row, const char *at, tcb_surface_record *r, tcb_error *err)
+{
+    if (!cJSON_IsArray(row) || cJSON_GetArraySize(row) != TCB_N_RECON + 1)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: expected [frame, %d values]", at, TCB_N_RECON);
+    int rc = pair_index(row->child, at, &r->frame, err), m = 0;
+    for (const cJSON *v = row->child->next; v && !rc; v = v->next, m++) rc = value_or_null(v, at, &r->v[m], err);
+    return rc;
+}
+
+/* The optional "surface" (none: n_surface 0). */
+static int load_surface(const cJSON *root, const char *where, tcb_cell_result *c, tcb_error *err)
+{
+    if (!cJSON_HasObjectItem(root, "surface")) return TCB_OK;
+    char sub[TCB_ERRMSG_MAX];
+    const cJSON *o, *rows;
+    long long v;
+    int rc = object_key(root, "surface", where, SURFACE_KEYS, &o, sub, sizeof sub, err);
+    if (rc || (rc = tcb_json_int(o, "samples", sub, 1, 0, 1, INT_MAX, &v, err))) return rc;
+    c->surface_samples = (int)v;
+    if (!surface_columns_ok(cJSON_GetObjectItemCaseSensitive(o, "columns")))
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.columns: expected [\"frame\", \"cdl2\", \"nc\", \"fscore05\", \"fscore1\"]",
+                        sub);
+    rows = cJSON_GetObjectItemCaseSensitive(o, "rows");
+    if (!cJSON_IsArray(rows) || cJSON_GetArraySize(rows) < 1)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.rows: expected an array of one row per evaluated frame", sub);
+    c->n_surface = cJSON_GetArraySize(rows);
+    c->surface = calloc((size_t)c->n_surface, sizeof *c->surface);
+    if (!c->surface) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", sub);
+    int k = 0;
+    for (const cJSON *row = rows->child; row && !rc; row = row->next, k++) {
+        char at[TCB_ERRMSG_MAX];
+        key_path(at, sizeof at, "%s.rows[%d]", sub, k);
+        rc = load_surface_row(row, at, &c->surface[k], err);
+        if (!rc && k > 0 && c->surface[k].frame <= c->surface[k - 1].frame)
+            rc = tcb_fail(err, TCB_ERR_INPUT, "%s: frame %d after frame %d (ascending, each once)", at,
+                          c->surface[k].frame, c->surface[k - 1].frame);
+    }
+    return rc;
+}
+
 static int load_params(const cJSON *root, const char *where, tcb_cell_result *c, tcb_error *err)
 {
     char sub[TCB_ERRMSG_MAX];
@@ -384,8 +441,14 @@ static int cell_from_json(const cJSON *root, const char *path, tcb_cell_result *
         (rc = load_timings_split(root, path, c, err)) ||
         (rc = load_summary(root, path, &c->summary, err)) ||
         (rc = load_pair_columns(root, path, &n_cols, err)) ||
-        (rc = load_pairs(root, n_cols, path, c, err)) || (rc = load_clips(root, path, c, err)))
+        (rc = load_pairs(root, n_cols, path, c, err)) || (rc = load_clips(root, path, c, err)) ||
+        (rc = load_surface(root, path, c, err)))
         return rc;
+    /* The summary's reconstruction metrics are over the cell's surface rows. */
+    for (int m = 0; m < TCB_N_RECON; m++)
+        if (c->summary.recon[m].n != c->n_surface)
+            return tcb_fail(err, TCB_ERR_INPUT, "%s.summary.%s: over %g frames, but the cell has %d surface rows",
+                            path, tcb_recon_names[m], c->summary.recon[m].n, c->n_surface);
     /* The summary's Corr is over the cell's clips, and only with clips. */
     if ((c->status == TCB_CELL_OK || c->n_clips == 0) && c->summary.corr.n != c->n_clips)
         return tcb_fail(err, TCB_ERR_INPUT, "%s.summary.corr: %s, but the cell has %d clips", path,

@@ -269,6 +269,7 @@ static int run_cell(const run_state *st, const seq_ctx *sc, const tcb_method_spe
         .interrupt_arg = st->opts->interrupt_arg,
         .clips = sc->clips,
         .clips_path = sc->clips_path,
+        .surface_samples = st->cfg->surface_samples,
     };
     char label[TCB_CELL_LABEL_MAX];
     tcb_cell_label(label, sizeof label, sc->dataset->name, sc->seq->name, m->label, seed);

@@ -18,7 +18,15 @@ const tcb_rpt_metric_def tcb_rpt_metrics[TCB_N_METRICS] = {
     {"geo_auc", "AUC_geo ↑", "AUC\\_geo $\\uparrow$", 1e2, 2, 0, 0},
     /* ×1e3 as m_sL2 (the papers print it raw: their 0.010 is 10.00 here). */
     {"corr", "Corr ↓", "Corr $\\downarrow$", 1e3, 2, 1, 0},
+    /* The reconstruction metrics: CD-L2 ×1e3 as CD, NC and F-score as
+     * percentages (the papers print them raw: their 0.95 is 95.00 here). */
+    {"cdl2", "CD-L2 ↓", "CD-L2 $\\downarrow$", 1e3, 3, 1, 0},
+    {"nc", "NC ↑", "NC $\\uparrow$", 1e2, 2, 0, 0},
+    {"fscore05", "F@0.5% ↑", "F@0.5\\% $\\uparrow$", 1e2, 2, 0, 0},
+    {"fscore1", "F@1% ↑", "F@1\\% $\\uparrow$", 1e2, 2, 0, 0},
 };
+_Static_assert(TCB_M_FSCORE1 - TCB_M_CDL2 + 1 == TCB_N_RECON && TCB_M_FSCORE1 + 1 == TCB_N_METRICS,
+               "the reconstruction columns are tcb/metrics.h's TCB_RECON_*, last");
 
 static int same_block(const tcb_cell_result *a, const tcb_cell_result *b)
 {
@@ -87,6 +95,7 @@ static int build_seeds(const tcb_cell_result *cells, int n, tcb_rpt_row *r, tcb_
         set_seed_stat(s, TCB_M_AUC, &c->summary.auc);
         set_seed_stat(s, TCB_M_CD, &c->summary.cd);
         set_seed_stat(s, TCB_M_CORR, &c->summary.corr);
+        for (int m = 0; m < TCB_N_RECON; m++) set_seed_stat(s, TCB_M_CDL2 + m, &c->summary.recon[m]);
         if (!all_geodesic(&c->summary)) continue;
         set_seed_stat(s, TCB_M_GEO, &c->summary.geo);
         set_seed_stat(s, TCB_M_GEO_AUC, &c->summary.geo_auc);
@@ -146,6 +155,7 @@ static int build_row(const tcb_cell_result *cells, int n, tcb_rpt_row *r, tcb_er
     set_stat(r, TCB_M_AUC, &pooled.auc);
     set_stat(r, TCB_M_CD, &pooled.cd);
     set_stat(r, TCB_M_CORR, &pooled.corr);
+    for (int m = 0; m < TCB_N_RECON; m++) set_stat(r, TCB_M_CDL2 + m, &pooled.recon[m]);
     r->sl2sq_mean = pooled.sl2sq.mean * 1e3;
     r->sl2sq_std = tcb_stat_std(&pooled.sl2sq) * 1e3;
     for (int s = 0; s < TCB_PCK_STEPS; s++) r->pck[s] = pooled.pck[s] * 100.0;

@@ -8,7 +8,8 @@
  * hides behind a number. The geodesic columns (tcb/geodesic.h, not the
  * paper's) show "-" unless every pooled pair has them: a cell written
  * before the geodesic error existed has none. Corr (×1e3, the clip
- * protocol's) shows "-" for cells that scored no clips. */
+ * protocol's) shows "-" for cells that scored no clips; CD-L2 (×1e3), NC
+ * and the F-scores (%) "-" for methods without surfaces and older cells. */
 #ifndef TCB_REPORTS_AGGREGATE_H
 #define TCB_REPORTS_AGGREGATE_H
 
@@ -27,6 +28,10 @@ typedef enum tcb_rpt_metric {
     TCB_M_GEO,      /* the geodesic error and its AUC: tcbench's addition */
     TCB_M_GEO_AUC,
     TCB_M_CORR,     /* the clip protocol's tracking error (DynoSurf/PDG/Neu-PiG), over clips */
+    TCB_M_CDL2,     /* the reconstruction metrics (tcb/metrics.h, TCB_RECON_* in this order), */
+    TCB_M_NC,       /* over the evaluated frames of the methods that give surfaces */
+    TCB_M_FSCORE05,
+    TCB_M_FSCORE1,
     TCB_N_METRICS
 } tcb_rpt_metric;
 

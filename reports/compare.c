@@ -13,6 +13,7 @@
 
 _Static_assert((int)TCB_CMP_N_METRICS == (int)TCB_N_METRICS, "compare.h's metrics are the report's columns");
 _Static_assert((int)TCB_CMP_SL2 == (int)TCB_M_SL2 && (int)TCB_CMP_CD == (int)TCB_M_CD && (int)TCB_CMP_CORR == (int)TCB_M_CORR &&
+                   (int)TCB_CMP_CDL2 == (int)TCB_M_CDL2 && (int)TCB_CMP_FSCORE1 == (int)TCB_M_FSCORE1 &&
                    (int)TCB_CMP_GEO_AUC == (int)TCB_M_GEO_AUC,
                "compare.h's metrics are in the report's column order");
 
@@ -21,7 +22,8 @@ const char *tcb_cmp_metric_key(int metric) { return tcb_rpt_metrics[metric].key;
 const char *tcb_cmp_metric_label(int metric)
 {
     static const char *const labels[TCB_CMP_N_METRICS] = {"m_sL2 ×1e3", "rank %",     "AUC %",   "CD ×1e3",
-                                                          "m_geo ×1e3", "AUC_geo %", "Corr ×1e3"};
+                                                          "m_geo ×1e3", "AUC_geo %", "Corr ×1e3",
+                                                          "CD-L2 ×1e3", "NC %",      "F@0.5% %", "F@1% %"};
     return labels[metric];
 }
 
@@ -43,12 +45,26 @@ static double pair_value(const tcb_pair_record *p, int m)
     }
 }
 
-/* The units metric m is paired over: clips for Corr, else pairs. */
-static int units(const tcb_cell_result *c, int m) { return m == TCB_M_CORR ? c->n_clips : c->n_pairs; }
+static int is_recon(int m) { return m >= TCB_M_CDL2 && m <= TCB_M_FSCORE1; }
+
+/* The units metric m is paired over: clips for Corr, evaluated frames for
+ * the reconstruction metrics, else pairs. */
+static int units(const tcb_cell_result *c, int m)
+{
+    return m == TCB_M_CORR ? c->n_clips : is_recon(m) ? c->n_surface : c->n_pairs;
+}
 
 static double unit_value(const tcb_cell_result *c, int u, int m)
 {
+    if (is_recon(m)) return c->surface[u].v[m - TCB_M_CDL2];
     return m == TCB_M_CORR ? c->clips[u].corr : pair_value(&c->pairs[u], m);
+}
+
+/* Unit u of c is unit u of first: the same frame (pairs and clips are
+ * checked with the split). */
+static int same_unit(const tcb_cell_result *c, const tcb_cell_result *first, int u, int m)
+{
+    return !is_recon(m) || c->surface[u].frame == first->surface[u].frame;
 }
 
 /* Cells c[0..n) of metric m into x[s][u] in table units over the units
@@ -62,7 +78,7 @@ static int fill(const tcb_cell_result *c, int n, int m, const tcb_cell_result *f
         if (units(&c[s], m) != count) return 0;
         for (int u = 0; u < count; u++) {
             double v = unit_value(&c[s], u, m);
-            if (!isfinite(v)) return 0;
+            if (!isfinite(v) || !same_unit(&c[s], first, u, m)) return 0;
             x[(size_t)s * count + u] = v * tcb_rpt_metrics[m].scale;
         }
     }
@@ -169,6 +185,7 @@ int tcb_compare_cells(const tcb_cell_result *a, int na, const tcb_cell_result *b
     int rc = check_cells(a, na, b, nb, err);
     if (rc) return rc;
     int most = a[0].n_pairs > a[0].n_clips ? a[0].n_pairs : a[0].n_clips;
+    if (a[0].n_surface > most) most = a[0].n_surface;
     double *xa = malloc(sizeof *xa * (size_t)most * (size_t)(na + nb + 2));
     if (!xa) return tcb_fail(err, TCB_ERR_NOMEM, "compare: out of memory");
     *out = (tcb_cmp){.seeds_a = na, .seeds_b = nb, .n = a[0].n_pairs, .single_seed = na == 1 || nb == 1,
@@ -179,6 +196,7 @@ int tcb_compare_cells(const tcb_cell_result *a, int na, const tcb_cell_result *b
         if (!fill(a, na, m, &a[0], xa) || !fill(b, nb, m, &a[0], xb)) continue;
         rc = compare_metric(xa, na, xb, nb, count, m, resamples, scratch, &out->m[m], err);
         if (m == TCB_M_CORR) out->n_clips = count;
+        if (is_recon(m)) out->n_frames = count;
     }
     free(xa);
     return rc;

@@ -126,6 +126,8 @@ static void print_result(FILE *f, const target *t, const tcb_cmp *c)
                 c->seeds_a, c->seeds_b);
     if (!c->over_sequences && c->n_clips)
         fprintf(f, "Corr: paired over the %d clips of the clip split instead of the pairs\n", c->n_clips);
+    if (!c->over_sequences && c->n_frames)
+        fprintf(f, "CD-L2, NC, F-scores: paired over the %d evaluated frames instead of the pairs\n", c->n_frames);
     if (c->single_seed)
         fprintf(f, "note: %s one seed: the interval covers the sampling of pairs only, not the training "
                    "variance (another training may score differently)\n",

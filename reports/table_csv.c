@@ -4,7 +4,10 @@
  * geodesic columns come last (geo_unreachable: vertices scored by the
  * straight-line fallback, summed over the pooled pairs), then per metric
  * the mark (<key>_mark): "best" (significantly better than every other
- * row), "tie" (a leader tied for best) or empty (docs/protocol.md).
+ * row), "tie" (a leader tied for best) or empty (docs/protocol.md); Corr
+ * before the marks, the reconstruction metrics (CD-L2, NC, F-scores) and
+ * their marks after them: each addition at the end, so older readers'
+ * columns stay put.
  *
  * by_gap.csv: one row per (dataset, sequence, method, frame distance) that
  * has pairs, for the methods whose cells are all ok.
@@ -50,6 +53,11 @@ static void put_mean_std(FILE *f, const tcb_rpt_row *r, int m)
     put_num(f, r->has[m], r->std[m], tcb_rpt_metrics[m].decimals);
 }
 
+static void put_marks(FILE *f, const tcb_rpt_row *r, int from, int to)
+{
+    for (int m = from; m < to; m++) fprintf(f, ",%s", r->best[m] ? "best" : r->tie[m] ? "tie" : "");
+}
+
 /* The paper's metrics and sL2² first, where they always were; the
  * additions (geodesic) after them, so older readers' columns stay put. */
 static void write_row(FILE *f, const tcb_rpt_block *b, const tcb_rpt_row *r)
@@ -64,9 +72,12 @@ static void write_row(FILE *f, const tcb_rpt_block *b, const tcb_rpt_row *r)
     for (int m = 0; m < TCB_M_CORR; m++)
         if (!tcb_rpt_metrics[m].paper) put_mean_std(f, r, m);
     put_num(f, r->has[TCB_M_GEO], r->geo_unreachable, 0);
-    /* Corr, added after geo_unreachable, goes after it; then the marks. */
-    for (int m = TCB_M_CORR; m < TCB_N_METRICS; m++) put_mean_std(f, r, m);
-    for (int m = 0; m < TCB_N_METRICS; m++) fprintf(f, ",%s", r->best[m] ? "best" : r->tie[m] ? "tie" : "");
+    /* Corr, added after geo_unreachable, goes after it; then the marks; the
+     * reconstruction metrics, added after the marks, after them with theirs. */
+    put_mean_std(f, r, TCB_M_CORR);
+    put_marks(f, r, 0, TCB_M_CDL2);
+    for (int m = TCB_M_CDL2; m < TCB_N_METRICS; m++) put_mean_std(f, r, m);
+    put_marks(f, r, TCB_M_CDL2, TCB_N_METRICS);
     fputc('\n', f);
 }
 
@@ -76,7 +87,9 @@ void tcb_rpt_write_csv(FILE *f, const tcb_rpt *r)
           "rank_pct_mean,rank_pct_std,auc_pct_mean,auc_pct_std,cd_x1e3_mean,cd_x1e3_std,"
           "sl2sq_x1e3_mean,sl2sq_x1e3_std,geo_x1e3_mean,geo_x1e3_std,geo_auc_pct_mean,"
           "geo_auc_pct_std,geo_unreachable,corr_x1e3_mean,corr_x1e3_std,sl2_mark,rank_mark,auc_mark,"
-          "cd_mark,geo_mark,geo_auc_mark,corr_mark\n",
+          "cd_mark,geo_mark,geo_auc_mark,corr_mark,cdl2_x1e3_mean,cdl2_x1e3_std,nc_pct_mean,nc_pct_std,"
+          "fscore05_pct_mean,fscore05_pct_std,fscore1_pct_mean,fscore1_pct_std,cdl2_mark,nc_mark,fscore05_mark,"
+          "fscore1_mark\n",
           f);
     for (int d = 0; d < r->n_datasets; d++) {
         const tcb_rpt_dataset *ds = &r->datasets[d];
@@ -108,7 +121,8 @@ void tcb_rpt_write_gap_csv(FILE *f, const tcb_rpt *r)
 void tcb_rpt_write_seed_csv(FILE *f, const tcb_rpt *r)
 {
     fputs("dataset,sequence,role,method,seed,status,n_pairs,sl2_x1e3_mean,rank_pct_mean,"
-          "auc_pct_mean,cd_x1e3_mean,geo_x1e3_mean,geo_auc_pct_mean,corr_x1e3_mean\n",
+          "auc_pct_mean,cd_x1e3_mean,geo_x1e3_mean,geo_auc_pct_mean,corr_x1e3_mean,cdl2_x1e3_mean,nc_pct_mean,"
+          "fscore05_pct_mean,fscore1_pct_mean\n",
           f);
     for (int k = 0; k < r->n_blocks; k++)
         for (int i = 0; i < r->blocks[k].n_rows; i++) {

@@ -220,7 +220,10 @@ void tcb_rpt_write_md(FILE *f, const tcb_rpt *r)
                "for best marked ≈ (the legend under each table); \"-\": the method has no reconstruction. Beside the paper's metrics, "
                "the geodesic error (docs/protocol.md): m_geo ×1e3 (path length on the target "
                "mesh over sqrt(its area), over all vertices of all pairs) and AUC_geo %% (its "
-               "PCK up to 0.25, over pairs); \"-\" there: cells scored before it existed.\n\n");
+               "PCK up to 0.25, over pairs); \"-\" there: cells scored before it existed. Corr ×1e3: the "
+               "clip protocol's tracking error, over clips. CD-L2 ×1e3, NC %% and F-score %% at 0.5 %% and "
+               "1 %% (F@0.5%%, F@1%%): the reconstruction metrics of DynoSurf's evaluation, over the "
+               "evaluated frames; \"-\" there: the method gives no surface (or its cells predate them).\n\n");
     tcb_rpt_write_presets_md(f, r);
     for (int k = 0; k < r->n_datasets; k++) write_dataset(f, r, &r->datasets[k]);
 }

@@ -45,11 +45,12 @@ static void write_dataset(FILE *f, const tcb_rpt *r, const tcb_rpt_dataset *d)
     fputs("\\begin{table}[t]\n\\centering\n\\caption{", f);
     tcb_rpt_tex_escaped(f, d->name);
     fputs(": m\\_sL2 $\\times 10^{3}$, rank \\%, AUC \\%, CD $\\times 10^{3}$, and the geodesic "
-          "error m\\_geo $\\times 10^{3}$ and AUC\\_geo \\% (not in the paper's protocol) (mean "
+          "error m\\_geo $\\times 10^{3}$ and AUC\\_geo \\%, Corr $\\times 10^{3}$, CD-L2 $\\times 10^{3}$, NC \\% "
+          "and the F-scores at 0.5\\,\\% and 1\\,\\% in \\% (not in the paper's protocol) (mean "
           "$\\pm$ std); in bold the best when significantly better than every other method (Holm-adjusted "
           "Wilcoxon $p < 0.05$ over the block's comparisons of the column and the 95\\,\\% bootstrap interval of "
           "the difference excluding 0), else $^{\\approx}$ on the leaders tied for best; ``-'': no reconstruction "
-          "(CD) or not scored (geodesic). MEAN: over the test sequences, its intervals rough with few of them.}\n\\begin{tabular}{ll",
+          "(CD), no clips (Corr), no surface (CD-L2, NC, F) or not scored (geodesic). MEAN: over the test sequences, its intervals rough with few of them.}\n\\begin{tabular}{ll",
           f);
     for (int m = 0; m < TCB_N_METRICS; m++) fputc('c', f);
     fputs("}\n\\toprule\nSequence & Method", f);

@@ -60,6 +60,7 @@ extern "C" {
 enum {
     TCB_CMP_SL2, TCB_CMP_RANK, TCB_CMP_AUC, TCB_CMP_CD, TCB_CMP_GEO, TCB_CMP_GEO_AUC,
     TCB_CMP_CORR, /* per clip of the clip protocol, not per pair */
+    TCB_CMP_CDL2, TCB_CMP_NC, TCB_CMP_FSCORE05, TCB_CMP_FSCORE1, /* per evaluated frame */
     TCB_CMP_N_METRICS
 };
 
@@ -76,6 +77,7 @@ typedef struct tcb_cmp {
     int seeds_a, seeds_b;    /* cells of each side (1 and 1 across sequences) */
     int n;                   /* pairs, or sequences when over_sequences */
     int n_clips;             /* clips behind Corr (0: Corr not compared) */
+    int n_frames;            /* frames behind the reconstruction metrics (0: not compared) */
     int over_sequences;      /* a MEAN row: the sequences were resampled */
     int single_seed;         /* a side has one seed: training variance left out */
     int resamples;

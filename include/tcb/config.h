@@ -27,7 +27,10 @@
  *                     "protocol": "pairs" | "clips" | ["pairs", "clips"],   the paper's
  *                                        pairs (default), the 17-frame clips of DynoSurf/PDG/
  *                                        Neu-PiG (Corr; docs/protocol.md), or both
- *                     "clips": 10 },     clips per sequence (clip protocol only)
+ *                     "clips": 10,       clips per sequence (clip protocol only)
+ *                     "surface_samples": 100000 },   samples per mesh of the
+ *                                        reconstruction metrics (CD-L2, NC, F-score)
+ *                                        of the methods that give surfaces
  *     "datasets": [
  *       { "name": "synth", "source": "synthetic", "seed": 0, "frames": 0,
  *         "normalization": "first_frame" | "none" | "per_frame",
@@ -127,6 +130,7 @@ typedef struct tcb_config {
     uint64_t split_seed;
     int protocols;           /* TCB_PROTOCOL_* bits, never 0 */
     int eval_clips;          /* clips per sequence under the clip protocol */
+    int surface_samples;     /* samples per mesh of the reconstruction metrics */
     int pool_size;
     uint64_t pool_seed;
     int input_points;

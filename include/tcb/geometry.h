@@ -35,6 +35,14 @@ void tcb_vertex_normals(const float *verts, int nv, const int32_t *faces, int nf
  * out is [n][3]. Fails on a zero-area mesh. */
 int tcb_sample_surface(const float *verts, const int32_t *faces, int nf, int n,
                        tcb_rng *rng, float *out, tcb_error *err);
+/* The same, and face_of[s] (when not NULL, [n]) the face sample s lies on:
+ * the same draws, so the same points for the same stream. */
+int tcb_sample_surface_faces(const float *verts, const int32_t *faces, int nf, int n,
+                             tcb_rng *rng, float *out, int32_t *face_of, tcb_error *err);
+
+/* The unit normal of triangle face ((b − a) × (c − a), corners in order);
+ * zero for a degenerate one. */
+void tcb_face_normal(const float *verts, const int32_t *face, float out[3]);
 
 #ifdef __cplusplus
 }

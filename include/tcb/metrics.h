@@ -21,6 +21,7 @@
 #include <stdint.h>
 
 #include "tcb/error.h"
+#include "tcb/rng.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -95,6 +96,37 @@ int tcb_chamfer(const float *a, int na, const float *b, int nb, double *out,
 int tcb_atlas_transfer(const float *src, int n, const float *pred_i, const float *pred_j,
                        int m, float *out, tcb_error *err);
 
+/* The reconstruction metrics of the 2024-2026 papers (DynoSurf's
+ * evaluation/utils.py, eval_mesh and eval_pointcloud, after Occupancy
+ * Networks' eval.py), on the surface a method gives of one frame
+ * (tcb_method_ops.surface) against the frame's GT mesh, each sampled with
+ * n area-uniform points carrying their face's unit normal. With
+ * acc_p = |p − nearest GT sample| for each predicted sample p and
+ * comp_q = |q − nearest predicted sample| for each GT sample q:
+ *   cdl2     = 0.5 (mean_p acc_p² + mean_q comp_q²)
+ *   nc       = 0.5 (mean_p |n_p · n_gt(p)| + mean_q |n_q · n_pred(q)|)
+ *   fscore_t = 2 P R / (P + R), P = frac_p [acc_p ≤ t], R = frac_q [comp_q ≤ t]
+ *              (0 when P + R = 0), t = 0.005 and 0.01 in the sequence's
+ *              normalized units (docs/protocol.md, "Reconstruction metrics"). */
+enum { TCB_RECON_CDL2, TCB_RECON_NC, TCB_RECON_FSCORE05, TCB_RECON_FSCORE1, TCB_N_RECON };
+#define TCB_FSCORE_T05 0.005
+#define TCB_FSCORE_T1 0.01
+#define TCB_DEFAULT_SURFACE_SAMPLES 100000
+
+/* "cdl2", "nc", "fscore05", "fscore1": the cell's keys, in enum order. */
+extern const char *const tcb_recon_names[TCB_N_RECON];
+
+/* n samples of a triangle mesh (tcb_sample_surface_faces) into pts [n][3]
+ * and the unit normal of each one's face into normals [n][3]. */
+int tcb_recon_sample(const float *verts, const int32_t *faces, int nf, int n, tcb_rng *rng,
+                     float *pts, float *normals, tcb_error *err);
+
+/* The metrics above of predicted samples (pred, pred_n: [np][3]) against
+ * GT samples (gt, gt_n: [ng][3]); out in enum order. Nearest neighbours by
+ * tcb/nn.h, their distances recomputed in double. */
+int tcb_recon_metrics(const float *pred, const float *pred_n, int np, const float *gt,
+                      const float *gt_n, int ng, double out[TCB_N_RECON], tcb_error *err);
+
 /* Everything measured on one (dataset, sequence, method, seed) cell. */
 typedef struct tcb_summary {
     int n_pairs;
@@ -112,6 +144,9 @@ typedef struct tcb_summary {
      * a clip's frames 1-16), over clips; n = 0 when no clip was scored (a
      * pairs-only run, an older cell). */
     tcb_stat corr;
+    /* The reconstruction metrics (TCB_RECON_*), over the cell's evaluated
+     * frames; n = 0 when the method gives no surface (or an older cell). */
+    tcb_stat recon[TCB_N_RECON];
 } tcb_summary;
 
 /* The clip protocol's tracking error at one frame t of a clip (DynoSurf's

@@ -51,7 +51,16 @@
  *               "rows": [[start, corr, [err_1, …, err_16]], …]}
  * (err_t: tcb_corr_frame at the clip's frame t; corr their mean); a cell
  * without clips has neither key (n_clips 0, corr.n 0: "-" in the Corr
- * column), and a clips-only cell has no pairs (split.n_pairs 0). */
+ * column), and a clips-only cell has no pairs (split.n_pairs 0).
+ * The reconstruction metrics (tcb/metrics.h, TCB_RECON_*; docs/protocol.md,
+ * "Reconstruction metrics") came later too: a cell whose method gives
+ * surfaces has "summary.cdl2", "summary.nc", "summary.fscore05" and
+ * "summary.fscore1" ({n, mean, m2} over its evaluated frames) and
+ *     "surface": {"samples": 100000,
+ *                 "columns": ["frame", "cdl2", "nc", "fscore05", "fscore1"],
+ *                 "rows": [[frame, cdl2, nc, fscore05, fscore1], …]}
+ * one row per evaluated frame (every frame of its pairs and clips, once,
+ * ascending); a cell without has none of these keys (n_surface 0: "-"). */
 #ifndef TCB_RESULTS_H
 #define TCB_RESULTS_H
 
@@ -80,6 +89,12 @@ typedef struct tcb_pair_record {
     double geo_auc;
     int geo_unreachable;       /* vertices scored by the Euclidean fallback */
 } tcb_pair_record;
+
+/* The reconstruction metrics of one evaluated frame. */
+typedef struct tcb_surface_record {
+    int frame;
+    double v[TCB_N_RECON];             /* TCB_RECON_* order */
+} tcb_surface_record;
 
 /* One clip of the clip protocol: frames start .. start + TCB_CLIP_FRAMES - 1. */
 typedef struct tcb_clip_record {
@@ -113,6 +128,11 @@ typedef struct tcb_cell_result {
     unsigned long long clips_seed;
     int n_clips;
     tcb_clip_record *clips;    /* malloc'ed [n_clips] */
+    /* The reconstruction metrics per evaluated frame; n_surface = 0: none
+     * (a method without surfaces, an older cell; summary.recon[].n 0). */
+    int surface_samples;       /* samples per mesh */
+    int n_surface;
+    tcb_surface_record *surface; /* malloc'ed [n_surface], ascending frame */
 } tcb_cell_result;
 
 /* <run>/cells/<dataset>/<sequence>/<method>/seed_<seed>.json */

@@ -11,7 +11,7 @@ trap 'rm -rf "$tmp"' EXIT
 cd "$tmp"
 cat > diverge.json <<'JSON'
 { "name": "diverge", "splits_dir": "splits", "cache_dir": "", "seeds": [0], "threads": 1,
-  "evaluation": { "pairs": 4, "pool_size": 1000, "input_points": 300 },
+  "evaluation": { "pairs": 4, "pool_size": 1000, "input_points": 300, "surface_samples": 500 },
   "datasets": [ { "name": "synth", "source": "synthetic", "frames": 6,
                   "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
   "methods": [ { "name": "mca", "params": { "preset": "tiny", "lr": 10 } } ] }

@@ -11,7 +11,7 @@ enter_temp_dir
 
 cat > train.json <<'JSON'
 { "name": "train", "splits_dir": "splits", "cache_dir": "", "seeds": [0], "threads": 1,
-  "evaluation": { "pairs": 4, "pool_size": 1000, "input_points": 300 },
+  "evaluation": { "pairs": 4, "pool_size": 1000, "input_points": 300, "surface_samples": 500 },
   "datasets": [ { "name": "synth", "source": "synthetic", "frames": 6,
                   "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
   "methods": [ { "name": "mca", "params": { "preset": "tiny", "iterations": 400, "checkpoint_every": 40 } } ] }

@@ -100,6 +100,8 @@ conf clipcount.json '{"evaluation": {"pairs": 2, "clips": 3}}'
 row "a clip count without the clip protocol" run clipcount.json
 conf short.json '{"evaluation": {"pairs": 2, "protocol": "clips"}}'
 row "the clip protocol on a sequence shorter than 17 frames" run short.json
+conf surface.json '{"evaluation": {"pairs": 2, "surface_samples": 0}}'
+row "no surface samples for the reconstruction metrics" run surface.json
 rm -rf runs splits
 
 # ---- OBJ frames
@@ -191,7 +193,7 @@ row "a baseline of other cells" "$TCBENCH" check runs/split other_base.json
 
 # ---- checkpoints
 section "Checkpoints (\`<run>/work/…\`): refused, then recomputed"
-conf ckpt.json '{"splits_dir": "splits_ckpt", "evaluation": {"pairs": 1, "pool_size": 200, "input_points": 100}, "seeds": [0, 1], "methods": [{"name": "mca", "params": {"preset": "tiny", "iterations": 10, "checkpoint_every": 0}}, {"name": "nricp", "seeds": [0], "params": {"strategy": "propagate_simple"}}]}'
+conf ckpt.json '{"splits_dir": "splits_ckpt", "evaluation": {"pairs": 1, "pool_size": 200, "input_points": 100, "surface_samples": 500}, "seeds": [0, 1], "methods": [{"name": "mca", "params": {"preset": "tiny", "iterations": 10, "checkpoint_every": 0}}, {"name": "nricp", "seeds": [0], "params": {"strategy": "propagate_simple"}}]}'
 run ckpt.json 2> /dev/null
 w=runs/ckpt/work/synth/quadruped_walk
 c=runs/ckpt/cells/synth/quadruped_walk

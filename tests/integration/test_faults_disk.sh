@@ -24,7 +24,7 @@ fi
 
 cat > cells.json <<'JSON'
 { "name": "disk", "splits_dir": "splits", "cache_dir": "", "seeds": [0, 1], "threads": 1,
-  "evaluation": { "pairs": 4, "pool_size": 400, "input_points": 150 },
+  "evaluation": { "pairs": 4, "pool_size": 400, "input_points": 150, "surface_samples": 500 },
   "datasets": [ { "name": "synth", "source": "synthetic", "frames": 4,
                   "sequences": [ { "name": "quadruped_walk", "role": "validation" },
                                  { "name": "quadruped_trot", "role": "test" } ] } ],
@@ -32,7 +32,7 @@ cat > cells.json <<'JSON'
 JSON
 cat > train.json <<'JSON'
 { "name": "disk_train", "splits_dir": "splits", "cache_dir": "", "seeds": [0], "threads": 1,
-  "evaluation": { "pairs": 4, "pool_size": 400, "input_points": 150 },
+  "evaluation": { "pairs": 4, "pool_size": 400, "input_points": 150, "surface_samples": 500 },
   "datasets": [ { "name": "synth", "source": "synthetic", "frames": 4,
                   "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
   "methods": [ { "name": "mca", "params": { "preset": "tiny", "iterations": 20, "checkpoint_every": 5 } } ] }

@@ -17,7 +17,7 @@ done
 config() { # NAME POOL_SIZE ITERATIONS
     cat <<JSON
 { "name": "$1", "splits_dir": "splits", "cache_dir": "cache", "seeds": [0], "threads": 1,
-  "evaluation": { "pairs": 2, "pool_size": $2, "input_points": 150 },
+  "evaluation": { "pairs": 2, "pool_size": $2, "input_points": 150, "surface_samples": 500 },
   "datasets": [ { "name": "files", "source": "objdir", "root": "data",
                   "sequences": [ { "name": "quadruped_walk", "role": "validation" },
                                  { "name": "quadruped_trot", "role": "test" } ] } ],

@@ -18,7 +18,7 @@ enter_temp_dir
 
 cat > grid.json <<'JSON'
 { "name": "kill", "splits_dir": "splits", "cache_dir": "", "seeds": [0], "threads": 1,
-  "evaluation": { "pairs": 4, "pool_size": 400, "input_points": 150 },
+  "evaluation": { "pairs": 4, "pool_size": 400, "input_points": 150, "surface_samples": 500 },
   "datasets": [ { "name": "synth", "source": "synthetic", "frames": 4,
                   "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
   "methods": [ { "name": "nearest" },

@@ -15,7 +15,7 @@ trap 'rm -rf "$tmp"' EXIT
 cd "$tmp"
 cat > frames.json <<'JSON'
 { "name": "frames", "splits_dir": "splits", "cache_dir": "", "seeds": [0], "threads": 1,
-  "evaluation": { "pairs": 4, "pool_size": 1000, "input_points": 300 },
+  "evaluation": { "pairs": 4, "pool_size": 1000, "input_points": 300, "surface_samples": 500 },
   "datasets": [ { "name": "synth", "source": "synthetic", "frames": 12,
                   "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
   "methods": [ { "name": "nearest" },

@@ -13,7 +13,7 @@ enter_temp_dir
 
 cat > train.json <<'JSON'
 { "name": "train", "splits_dir": "splits", "cache_dir": "", "seeds": [0], "threads": 1,
-  "evaluation": { "pairs": 20, "pool_size": 1000, "input_points": 300 },
+  "evaluation": { "pairs": 20, "pool_size": 1000, "input_points": 300, "surface_samples": 500 },
   "datasets": [ { "name": "synth", "source": "synthetic", "frames": 6,
                   "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
   "methods": [ { "name": "mca", "params": { "preset": "tiny", "iterations": 400, "checkpoint_every": 0 } } ] }
@@ -57,7 +57,7 @@ same_cells full stopped
 # the rerun registers only the others and ends with the same cell.
 cat > maps.json <<'JSON'
 { "name": "maps", "splits_dir": "maps_splits", "cache_dir": "", "seeds": [0], "threads": 1,
-  "evaluation": { "pairs": 20, "pool_size": 1000, "input_points": 300 },
+  "evaluation": { "pairs": 20, "pool_size": 1000, "input_points": 300, "surface_samples": 500 },
   "datasets": [ { "name": "synth", "source": "synthetic", "frames": 24,
                   "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
   "methods": [ { "name": "nricp", "params": { "strategy": "propagate_bijective" } } ] }

@@ -2,7 +2,8 @@
 # The default benchmark (configs/quick.json: every method family on the
 # three embedded sequences) reproduces the committed regression baseline:
 # `tcbench check` exits 0, oracle is perfect, every cell is ok and the
-# methods that reconstruct have a Chamfer distance.
+# methods that reconstruct have a Chamfer distance, the atlas methods the
+# reconstruction metrics (on 3 000 samples, the config's deviation).
 #
 # It runs the Release binary (TCBENCH_RELEASE, which scripts/test.sh builds
 # and sets; skipped without it): the 24 cells would take most of the
@@ -49,5 +50,9 @@ for c in cells:
         assert s["sl2"]["mean"] > 0 and s["auc"]["mean"] < 1, s
         assert s["geo"]["mean"] > 0 and s["geo_auc"]["mean"] < 1, s
     assert (s["cd"] is not None) == (c["method"] in reconstructs), c["method"]
+    # the surface methods' reconstruction metrics, on every frame of the 500 pairs
+    assert ("surface" in c) == (c["method"] in reconstructs) == ("cdl2" in s), c["method"]
+    if "surface" in c:
+        assert c["surface"]["samples"] == 3000 and s["cdl2"]["n"] == len(c["surface"]["rows"]) > 0, s["cdl2"]
 print("quick config: %d cells ok" % len(cells))
 PY

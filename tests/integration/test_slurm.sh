@@ -30,7 +30,7 @@ export SLURM_CONF="$tmp/slurm.conf"
 # A grid of four cells, submitted as an array of one-CPU tasks.
 cat > grid.json <<'JSON'
 { "name": "grid", "splits_dir": "splits", "cache_dir": "", "seeds": [0, 1], "threads": 1,
-  "evaluation": { "pairs": 5, "pool_size": 1000, "input_points": 300 },
+  "evaluation": { "pairs": 5, "pool_size": 1000, "input_points": 300, "surface_samples": 500 },
   "datasets": [ { "name": "synth", "source": "synthetic", "frames": 6,
                   "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
   "methods": [ { "name": "nearest" },

@@ -20,22 +20,12 @@
 #include "tcb/json.h"
 #include "tcb/rng.h"
 #include "tcb/sequence.h"
+#include "write_bin.h"
 
 static int die(const tcb_error *err)
 {
     fprintf(stderr, "geodesic_dump: %s\n", err->msg);
     return 1;
-}
-
-static int write_bin(const char *dir, const char *name, const void *data, size_t bytes, tcb_error *err)
-{
-    char path[TCB_PATH_MAX];
-    int rc = tcb_path_join(path, sizeof path, err, "%s/%s", dir, name);
-    if (rc) return rc;
-    FILE *f = fopen(path, "wb");
-    if (!f || fwrite(data, 1, bytes, f) != bytes || fclose(f))
-        return tcb_fail(err, TCB_ERR_IO, "%s: cannot write", path);
-    return TCB_OK;
 }
 
 static int write_json(const char *dir, const tcb_sequence *s, int j, const tcb_pair_metrics *m,
@@ -95,10 +85,10 @@ int main(int argc, char **argv)
     if (!rc) rc = tcb_edge_graph_build(s.faces, s.n_faces, s.n_verts, &g, &err);
     if (!rc) rc = tcb_pair_geodesic_compute(&g, tcb_seq_frame(&s, j), s.areas[j], pred, &m, geo, &err);
     if (!rc) rc = tcb_mkdirs(out, &err);
-    if (!rc) rc = write_bin(out, "verts.bin", tcb_seq_frame(&s, j), nv * 3 * sizeof(float), &err);
-    if (!rc) rc = write_bin(out, "faces.bin", s.faces, (size_t)s.n_faces * 3 * sizeof(int32_t), &err);
-    if (!rc) rc = write_bin(out, "pred.bin", pred, nv * sizeof *pred, &err);
-    if (!rc) rc = write_bin(out, "geo.bin", geo, nv * sizeof *geo, &err);
+    if (!rc) rc = tcb_test_write_bin(out, "verts.bin", tcb_seq_frame(&s, j), nv * 3 * sizeof(float), &err);
+    if (!rc) rc = tcb_test_write_bin(out, "faces.bin", s.faces, (size_t)s.n_faces * 3 * sizeof(int32_t), &err);
+    if (!rc) rc = tcb_test_write_bin(out, "pred.bin", pred, nv * sizeof *pred, &err);
+    if (!rc) rc = tcb_test_write_bin(out, "geo.bin", geo, nv * sizeof *geo, &err);
     if (!rc) rc = write_json(out, &s, j, &m, &err);
     tcb_edge_graph_free(&g);
     free(pred);

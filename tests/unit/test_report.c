@@ -320,7 +320,7 @@ static void test_md_per_seed_table(void **state)
 
 /* ------------------------------------------------------------------ CSV */
 
-#define CSV_MAX_FIELDS 31
+#define CSV_MAX_FIELDS 43
 typedef struct csv_row {
     char field[CSV_MAX_FIELDS][64];
 } csv_row;
@@ -390,16 +390,17 @@ static void test_csv_parses_back(void **state)
 {
     fixture *f = *state;
     int n;
-    csv_row *rows = read_csv(f, "results.csv", 31, &n);
+    csv_row *rows = read_csv(f, "results.csv", 43, &n);
     /* header + 4 sequences × 3 methods + anim's 3 MEAN rows */
     assert_int_equal(n, 1 + 12 + 3);
-    assert_string_equal(rows[0].field[7], "sl2_x1e3_mean");
-    assert_string_equal(rows[0].field[15], "sl2sq_x1e3_mean");
-    assert_string_equal(rows[0].field[17], "geo_x1e3_mean");
-    assert_string_equal(rows[0].field[21], "geo_unreachable");
-    assert_string_equal(rows[0].field[22], "corr_x1e3_mean");
-    assert_string_equal(rows[0].field[24], "sl2_mark");
-    assert_string_equal(rows[0].field[30], "corr_mark");
+    /* where the columns are: every addition at the end (Corr before the
+     * marks, the reconstruction metrics and their marks after them) */
+    static const struct { int at; const char *name; } cols[] = {
+        {7, "sl2_x1e3_mean"},   {15, "sl2sq_x1e3_mean"},  {17, "geo_x1e3_mean"},   {21, "geo_unreachable"},
+        {22, "corr_x1e3_mean"}, {24, "sl2_mark"},         {30, "corr_mark"},       {31, "cdl2_x1e3_mean"},
+        {33, "nc_pct_mean"},    {35, "fscore05_pct_mean"}, {37, "fscore1_pct_mean"}, {39, "cdl2_mark"},
+        {42, "fscore1_mark"}};
+    for (size_t k = 0; k < sizeof cols / sizeof *cols; k++) assert_string_equal(rows[0].field[cols[k].at], cols[k].name);
     expect an = expected(1, 0), nn = expected(1, 1);
     const csv_row *r = find_csv(rows, n, "horse", "AN");
     assert_string_equal(r->field[2], "test");
@@ -411,6 +412,8 @@ static void test_csv_parses_back(void **state)
     /* 2 pairs: nothing significant, every row tied for best (NN has no CD) */
     assert_string_equal(r->field[24], "tie");
     assert_string_equal(find_csv(rows, n, "horse", "NN")->field[27], "");
+    /* no fake cell has surfaces: empty reconstruction fields */
+    for (int k = 31; k < 43; k++) assert_string_equal(r->field[k], "");
     const int tests[] = {1, 2};
     expect mean = expected_mean(tests, 2, 0);
     r = find_csv(rows, n, "MEAN", "AN");
@@ -484,7 +487,9 @@ static void test_seed_csv_one_row_per_cell(void **state)
 {
     fixture *f = *state;
     int n;
-    csv_row *rows = read_csv(f, "seeds.csv", 14, &n);
+    csv_row *rows = read_csv(f, "seeds.csv", 18, &n);
+    assert_string_equal(rows[0].field[14], "cdl2_x1e3_mean");
+    assert_string_equal(rows[0].field[17], "fscore1_pct_mean");
     assert_string_equal(rows[0].field[4], "seed");
     int n_cells = 0;
     for (int m = 0; m < N_METHODS; m++) n_cells += N_SEQS * METHODS[m].n_seeds;
@@ -533,8 +538,9 @@ static void test_tex_uses_booktabs(void **state)
     assert_contains(tex, "\\midrule");
     assert_contains(tex, "\\bottomrule");
     assert_contains(tex, "m\\_sL2 $\\downarrow$");
-    assert_contains(tex, "m\\_geo $\\downarrow$ & AUC\\_geo $\\uparrow$ & Corr $\\downarrow$ \\\\");
-    assert_contains(tex, "\\begin{tabular}{llccccccc}");
+    assert_contains(tex, "m\\_geo $\\downarrow$ & AUC\\_geo $\\uparrow$ & Corr $\\downarrow$ & CD-L2 $\\downarrow$ & NC "
+                         "$\\uparrow$ & F@0.5\\% $\\uparrow$ & F@1\\% $\\uparrow$ \\\\");
+    assert_contains(tex, "\\begin{tabular}{llccccccccccc}");
     /* DSR leads, tied for best (2 pairs: nothing can be significant) */
     expect dsr = expected(1, 2);
     char tied[128];
@@ -625,12 +631,14 @@ static void test_old_cells_show_dash(void **state)
     char *old = md_line(md, "OLD (seed 0)"), *neu = md_line(md, "NEW (seed 0)"), *mix = md_line(md, "MIX");
     /* OLD: leads on the paper's m_sL2 (tied for best: 2 pairs cannot make it
      * significant), "-" for the geodesic error */
-    if (strncmp(old, "| OLD (seed 0) | ", 17) || !strstr(old, " ≈ |") || !ends_with(old, " | - | - |"))
-        fail_msg("%s", old);
-    if (!ends_with(mix, " | - | - |")) fail_msg("%s", mix);
+    /* (the last five columns, Corr and the reconstruction metrics: "-" in
+     * every row, no cell has clips or surfaces) */
+    const char *none5 = " | - | - | - | - | - |", *none6 = "| - | - | - | - | - | - |";
+    if (strncmp(old, "| OLD (seed 0) | ", 17) || !strstr(old, " ≈ |") || !ends_with(old, none6)) fail_msg("%s", old);
+    if (!ends_with(mix, none6)) fail_msg("%s", mix);
     /* NEW alone has geodesic numbers, with nothing to compare: not marked;
      * no cell scored clips: "-" under Corr (the last column) */
-    if (!ends_with(neu, " | - |") || strstr(neu, "| - | - |") || strstr(neu, "** | - |") || strstr(neu, "≈ | - |"))
+    if (!ends_with(neu, none5) || strstr(neu, none6) || strstr(neu, "** | - |") || strstr(neu, "≈ | - |"))
         fail_msg("%s", neu);
     snprintf(path, sizeof path, "%s/report/pck_geo_anim_horse.png", dir);
     assert_true(tcb_is_file(path));

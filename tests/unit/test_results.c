@@ -116,7 +116,29 @@ static void assert_cells_equal(const tcb_cell_result *a, const tcb_cell_result *
     assert_string_equal(a->clips_path, b->clips_path);
     assert_true(a->clips_seed == b->clips_seed);
     if (a->n_clips) assert_memory_equal(a->clips, b->clips, (size_t)a->n_clips * sizeof *a->clips);
+    for (int m = 0; m < TCB_N_RECON; m++) assert_stat_equal(&s->recon[m], &t->recon[m]);
+    assert_int_equal(a->n_surface, b->n_surface);
+    assert_int_equal(a->n_surface ? a->surface_samples : 0, b->n_surface ? b->surface_samples : 0);
+    if (a->n_surface) assert_memory_equal(a->surface, b->surface, (size_t)a->n_surface * sizeof *a->surface);
 }
+
+/* Three evaluated frames' reconstruction metrics into c (records in rows[3]). */
+static void add_surface(tcb_cell_result *c, tcb_surface_record *rows)
+{
+    c->surface_samples = 1000;
+    c->n_surface = 3;
+    c->surface = rows;
+    for (int k = 0; k < 3; k++) {
+        rows[k].frame = 2 * k + 1;
+        for (int m = 0; m < TCB_N_RECON; m++) {
+            rows[k].v[m] = (m ? 0.9 : 1e-4) / (k + m + 1.0);
+            tcb_stat_push(&c->summary.recon[m], rows[k].v[m]);
+        }
+    }
+}
+
+/* What a test cell carries besides the pairs. */
+enum { WITH_CLIPS = 1, WITH_SURFACE = 2 };
 
 /* Two clips of the clip protocol into c (records in clips[2]). */
 static void add_clips(tcb_cell_result *c, tcb_clip_record *clips)
@@ -136,16 +158,18 @@ static void add_clips(tcb_cell_result *c, tcb_clip_record *clips)
     }
 }
 
-static void round_trip(int with_cd, int with_clips)
+static void round_trip(int with_cd, int with)
 {
     char dir[512], path[4096];
     tu_make_tmpdir(dir, sizeof dir);
     tcb_pair_record pairs[3];
     tcb_clip_record clips[2];
+    tcb_surface_record surface[3];
     tcb_cell_result c, back;
     tcb_error err = {0};
     make_cell(&c, "anim", "horse", "OUR", 3, with_cd, pairs);
-    if (with_clips) add_clips(&c, clips);
+    if (with & WITH_CLIPS) add_clips(&c, clips);
+    if (with & WITH_SURFACE) add_surface(&c, surface);
     assert_int_equal(tcb_cell_path(path, sizeof path, dir, "anim", "horse", "OUR", 3, &err), 0);
     assert_int_equal(tcb_cell_save(path, &c, &err), TCB_OK);
     assert_int_equal(tcb_cell_load(path, &back, &err), TCB_OK);
@@ -281,16 +305,18 @@ typedef void (*json_edit)(cJSON *root);
 /* Saves a valid cell (with two clips when with_clips), applies `edit` to
  * its JSON, and expects loading to fail with TCB_ERR_INPUT naming the file
  * and `key`. */
-static void expect_rejected_cell(json_edit edit, const char *key, int with_clips)
+static void expect_rejected_cell(json_edit edit, const char *key, int with)
 {
     char dir[512], path[4096];
     tu_make_tmpdir(dir, sizeof dir);
     tcb_pair_record pairs[3];
     tcb_clip_record clips[2];
+    tcb_surface_record surface[3];
     tcb_cell_result c, back;
     tcb_error err = {0};
     make_cell(&c, "anim", "cat", "AN", 0, 1, pairs);
-    if (with_clips) add_clips(&c, clips);
+    if (with & WITH_CLIPS) add_clips(&c, clips);
+    if (with & WITH_SURFACE) add_surface(&c, surface);
     assert_int_equal(tcb_cell_path(path, sizeof path, dir, "anim", "cat", "AN", 0, &err), 0);
     assert_int_equal(tcb_cell_save(path, &c, &err), TCB_OK);
     cJSON *root;
@@ -303,6 +329,7 @@ static void expect_rejected_cell(json_edit edit, const char *key, int with_clips
         fail_msg("message \"%s\" does not name %s and %s", err.msg, path, key);
     assert_null(back.pairs);
     assert_null(back.clips);
+    assert_null(back.surface);
     assert_null(back.params_json);
     tu_remove_tree(dir);
 }
@@ -471,7 +498,47 @@ static void test_loads_cell_without_geodesic(void **state)
 static void test_round_trip_with_clips(void **state)
 {
     (void)state;
-    round_trip(0, 1);
+    round_trip(0, WITH_CLIPS);
+}
+
+static void test_round_trip_with_surface(void **state)
+{
+    (void)state;
+    round_trip(1, WITH_SURFACE | WITH_CLIPS);
+}
+
+static cJSON *surface_of(cJSON *r) { return cJSON_GetObjectItem(r, "surface"); }
+static void drop_nc(cJSON *r) { cJSON_DeleteItemFromObject(cJSON_GetObjectItem(r, "summary"), "nc"); }
+static void drop_surface(cJSON *r) { cJSON_DeleteItemFromObject(r, "surface"); }
+static void surface_columns_swapped(cJSON *r)
+{
+    cJSON_ReplaceItemInArray(cJSON_GetObjectItem(surface_of(r), "columns"), 1, cJSON_CreateString("nc"));
+}
+static void surface_frames_unsorted(cJSON *r)
+{
+    cJSON *row = cJSON_GetArrayItem(cJSON_GetObjectItem(surface_of(r), "rows"), 2);
+    cJSON_ReplaceItemInArray(row, 0, cJSON_CreateNumber(1));
+}
+static void surface_row_short(cJSON *r)
+{
+    cJSON_DeleteItemFromArray(cJSON_GetArrayItem(cJSON_GetObjectItem(surface_of(r), "rows"), 0), 4);
+}
+static void surface_samples_zero(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(surface_of(r), "samples", cJSON_CreateNumber(0));
+}
+
+/* The reconstruction keys go together: summary and rows agree, columns in
+ * order, frames ascending, each row complete. */
+static void test_rejects_bad_surface(void **state)
+{
+    (void)state;
+    expect_rejected_cell(drop_nc, "summary.nc: over 0 frames, but the cell has 3 surface rows", WITH_SURFACE);
+    expect_rejected_cell(drop_surface, "summary.cdl2: over 3 frames, but the cell has 0", WITH_SURFACE);
+    expect_rejected_cell(surface_columns_swapped, "surface.columns", WITH_SURFACE);
+    expect_rejected_cell(surface_frames_unsorted, "surface.rows[2]: frame 1 after frame 3", WITH_SURFACE);
+    expect_rejected_cell(surface_row_short, "surface.rows[0]", WITH_SURFACE);
+    expect_rejected_cell(surface_samples_zero, "surface.samples", WITH_SURFACE);
 }
 
 static void drop_corr(cJSON *r) { cJSON_DeleteItemFromObject(cJSON_GetObjectItem(r, "summary"), "corr"); }
@@ -599,6 +666,8 @@ int main(void)
         cmocka_unit_test(test_rejects_partial_geodesic),
         cmocka_unit_test(test_loads_cell_without_geodesic),
         cmocka_unit_test(test_round_trip_with_clips),
+        cmocka_unit_test(test_round_trip_with_surface),
+        cmocka_unit_test(test_rejects_bad_surface),
         cmocka_unit_test(test_rejects_bad_clips),
         cmocka_unit_test(test_rejects_bad_json),
         cmocka_unit_test(test_scan_sorts_and_skips_non_cells),
