@@ -20,7 +20,7 @@ cd "$tmp"
 export XDG_CONFIG_HOME="$tmp/config" # no calibration of the user's is read
 
 cat > small.json <<'JSON'
-{ "name": "small", "output": "run", "seeds": [0], "threads": 1, "evaluation": { "pairs": 24 },
+{ "name": "small", "output": "run", "seeds": [0], "threads": 1, "evaluation": { "pairs": 24, "surface_samples": 500 },
   "datasets": [ { "name": "s", "source": "synthetic", "frames": 10,
                   "sequences": [ { "name": "quadruped_walk", "role": "test" } ] } ],
   "methods": [ { "name": "atlasnet", "params": { "preset": "tiny", "iterations": 80 } },
