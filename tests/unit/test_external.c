@@ -378,7 +378,7 @@ static void test_transfer_needs_prepared_pairs(void **state)
     assert_int_equal(tcb_method_external.transfer(self, &seq, 0, 1, src, 1, out, NULL, &err), TCB_ERR_INTERNAL);
     expect_text(err.msg, "external: pair 0->1 is not the one prepare_pairs announced next");
     tcb_method_external.destroy(self);
-    assert_int_equal(tcb_method_external.abi_version, 4);
+    assert_true(tcb_method_external.abi_version >= 4); /* prepare_pairs is read from 4 on */
     assert_non_null(tcb_method_external.prepare_pairs);
 }
 
