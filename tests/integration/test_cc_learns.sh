@@ -16,7 +16,9 @@
 # It runs the Release binary when scripts/test.sh provides one
 # (TCBENCH_RELEASE): the claim is about learning, 2 000 steps under the
 # sanitizers took 7 minutes of the suite, and cc's code runs sanitized in
-# test_cc_train and test_cc_pytorch.
+# test_cc_train and test_cc_pytorch. Measured with the Release build (200
+# pairs): loss 0.409 -> 0.279 (0.68), rank 0.0112 vs 0.0220 (0.51), m_sL2
+# 0.0377 vs 0.0438 (0.86): the same margins hold for both builds.
 set -euo pipefail
 : "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
 bin=${TCBENCH_RELEASE:-$TCBENCH}
