@@ -1,13 +1,17 @@
 /* `tcbench calibrate`: the costs the dry run prices cells with, measured on
  * this machine (harness/calibration.h).
  *
- * Every registered method with train_steps, at each of its presets and
- * each thread count asked, is one measurement: a warm-up step, then steps
- * until its share of the budget (what is left, over the measurements left)
- * is spent, at least one and at most MAX_STEPS; then a few evaluation
- * pairs, which also time the harness's scoring. A measurement whose
- * warm-up and one step exceed its share overruns the budget, which the
- * closing line says. */
+ * Every registered method with train_steps or units, at each of its
+ * presets (one without presets: once, created with "{}") and each thread
+ * count asked, is one measurement. Its share of the budget (what is left,
+ * over the measurements left) is split between its steps and each unit:
+ * the steps are a warm-up step, then steps while their part lasts, at
+ * least one and at most MAX_STEPS, then a few evaluation pairs, which also
+ * time the harness's scoring, and the reconstruction metrics of a few
+ * frames for a method with a surface; each unit is an untimed run, then
+ * runs while its part lasts, at least one. A measurement whose warm-ups
+ * and single runs exceed its share overruns the budget, which the closing
+ * line says. */
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,7 +21,10 @@
 #include "tcb/fsutil.h"
 #include "tcb/registry.h"
 
-enum { MAX_STEPS = 50, QUICK_MAX_STEPS = 5, EVAL_PAIRS = 6, QUICK_EVAL_PAIRS = 1 };
+enum {
+    MAX_STEPS = 50, QUICK_MAX_STEPS = 5, EVAL_PAIRS = 6, QUICK_EVAL_PAIRS = 1,
+    MAX_UNIT_RUNS = 10, QUICK_UNIT_RUNS = 2, SURFACE_FRAMES = 3, QUICK_SURFACE_FRAMES = 1
+};
 
 typedef struct measurement {
     const tcb_method_ops *ops;
@@ -25,20 +32,35 @@ typedef struct measurement {
     int threads;
 } measurement;
 
-static int calibrated(const tcb_method_ops *ops)
+static int has_presets(const tcb_method_ops *ops)
 {
-    return ops->abi_version >= 5 && ops->train_steps && ops->presets && ops->presets[0];
+    return ops->abi_version >= 5 && ops->presets && ops->presets[0];
+}
+
+static int has_steps(const tcb_method_ops *ops)
+{
+    return has_presets(ops) && ops->train_steps;
+}
+
+static int n_units(const tcb_method_ops *ops)
+{
+    int n = 0;
+    while (ops->abi_version >= 6 && ops->run_unit && ops->units && ops->units[n]) n++;
+    return n;
 }
 
 /* Appends ops's measurements (its presets, or o->preset, x the thread
- * counts) to m unless NULL; returns the presets. */
+ * counts; a method without presets: "") to m unless NULL; returns the
+ * presets. */
 static int plan_method(const tcb_calibrate_opts *o, const tcb_method_ops *ops, measurement *m, int *n)
 {
+    static const char *const no_presets[] = {"", NULL};
+    const char *const *presets = has_presets(ops) ? ops->presets : no_presets;
     int found = 0;
-    for (int p = 0; ops->presets[p]; p++) {
-        if (o->preset && strcmp(o->preset, ops->presets[p])) continue;
+    for (int p = 0; presets[p]; p++) {
+        if (o->preset && strcmp(o->preset, presets[p])) continue;
         found++;
-        for (int t = 0; m && t < o->n_threads; t++) m[(*n)++] = (measurement){ops, ops->presets[p], o->threads[t]};
+        for (int t = 0; m && t < o->n_threads; t++) m[(*n)++] = (measurement){ops, presets[p], o->threads[t]};
     }
     return found;
 }
@@ -50,12 +72,13 @@ static int plan(const tcb_calibrate_opts *o, measurement *m, int *n, tcb_error *
     int methods = 0, presets = 0, counted = 0;
     for (int k = 0; k < tcb_registry_count(); k++) {
         const tcb_method_ops *ops = tcb_registry_get(k);
-        if (!calibrated(ops) || (o->method && strcmp(o->method, ops->name))) continue;
+        if (!(has_steps(ops) || n_units(ops)) || (o->method && strcmp(o->method, ops->name))) continue;
         methods++;
         presets += plan_method(o, ops, m, &counted);
     }
     if (o->method && !methods)
-        return tcb_fail(err, TCB_ERR_INPUT, "calibrate: --only %s: no method of that name trains in steps", o->method);
+        return tcb_fail(err, TCB_ERR_INPUT, "calibrate: --only %s: no method of that name has costs to measure "
+                        "(training steps or units)", o->method);
     if (o->preset && !presets)
         return tcb_fail(err, TCB_ERR_INPUT, "calibrate: --preset %s: no preset of that name%s%s", o->preset,
                         o->method ? " in " : "", o->method ? o->method : "");
@@ -76,34 +99,68 @@ typedef struct session {
 
 static int add(tcb_calibration *cal, tcb_cost_kind kind, const measurement *m, double s, int samples, tcb_error *err)
 {
-    tcb_cost_entry e = {kind, "", "", m->threads, samples, s};
+    tcb_cost_entry e = {kind, "", "", m->threads, samples, s, "", 0};
     snprintf(e.method, sizeof e.method, "%s", m->ops->name);
     snprintf(e.preset, sizeof e.preset, "%s", m->preset);
     return tcb_calibration_add(cal, &e, err);
 }
 
+/* The steps, the evaluation pairs and, for a method with a surface, the
+ * reconstruction metrics of a few frames; the pairs' scoring summed into
+ * s->score_*[t_index]. */
+static int measure_steps(const session *s, const measurement *m, void *self, int t_index, double budget_s,
+                         tcb_error *err)
+{
+    const tcb_calibrate_opts *o = s->o;
+    tcb_fit_ctx ctx = {.seed = 0, .n_threads = m->threads};
+    tcb_step_timing t;
+    double method_s = 0, score_s = 0, frame_s = 0;
+    int pairs = o->quick ? QUICK_EVAL_PAIRS : EVAL_PAIRS, frames = o->quick ? QUICK_SURFACE_FRAMES : SURFACE_FRAMES;
+    int surface = tcb_method_has_surface(m->ops) && o->surface_samples > 0;
+    int rc = tcb_time_train_steps(m->ops, self, s->seq, &ctx, o->quick ? QUICK_MAX_STEPS : MAX_STEPS, budget_s, &t,
+                                  err);
+    if (!rc) rc = tcb_time_eval_pairs(m->ops, self, s->seq, pairs, &method_s, &score_s, err);
+    if (!rc && surface) rc = tcb_time_surface_frames(m->ops, self, s->seq, frames, o->surface_samples, &frame_s, err);
+    if (!rc) rc = add(s->cal, TCB_COST_STEP, m, t.step_s, t.steps, err);
+    if (!rc) rc = add(s->cal, TCB_COST_EVAL_PAIR, m, method_s, pairs, err);
+    if (!rc && surface && !(rc = add(s->cal, TCB_COST_SURFACE_FRAME, m, frame_s, frames, err)))
+        s->cal->entries[s->cal->n - 1].size = o->surface_samples;
+    if (rc) return rc;
+    s->score_s[t_index] += score_s * pairs, s->score_n[t_index] += pairs;
+    fprintf(s->out, "%9.1f ms/step (%2d steps after a %.1f s warm-up) %8.1f ms/pair", t.step_s * 1e3, t.steps,
+            t.first_s, method_s * 1e3);
+    if (surface) fprintf(s->out, " %7.2f s/surface frame", frame_s);
+    return TCB_OK;
+}
+
+/* Unit k of the method: its seconds per run. */
+static int measure_unit(const session *s, const measurement *m, void *self, int k, double budget_s, tcb_error *err)
+{
+    tcb_fit_ctx ctx = {.seed = 0, .n_threads = m->threads};
+    tcb_step_timing t;
+    int rc = tcb_time_unit(m->ops, self, s->seq, &ctx, k, s->o->quick ? QUICK_UNIT_RUNS : MAX_UNIT_RUNS, budget_s, &t,
+                           err);
+    if (!rc && !(rc = add(s->cal, TCB_COST_UNIT, m, t.step_s, t.steps, err)))
+        snprintf(s->cal->entries[s->cal->n - 1].unit, sizeof s->cal->entries[0].unit, "%s", m->ops->units[k]);
+    if (rc) tcb_error_prefix(err, "unit %s: ", m->ops->units[k]);
+    else fprintf(s->out, " %s %.3g s", m->ops->units[k], t.step_s);
+    return rc;
+}
+
 static int measure(const session *s, const measurement *m, int t_index, double share, tcb_error *err)
 {
     char params[128];
-    snprintf(params, sizeof params, "{\"preset\": \"%s\"}", m->preset);
+    snprintf(params, sizeof params, m->preset[0] ? "{\"preset\": \"%s\"}" : "{}", m->preset);
     void *self;
     int rc = m->ops->create(params, &self, err);
     if (rc) return rc;
-    tcb_fit_ctx ctx = {.seed = 0, .n_threads = m->threads};
-    tcb_step_timing t;
-    double method_s = 0, score_s = 0;
-    int pairs = s->o->quick ? QUICK_EVAL_PAIRS : EVAL_PAIRS;
-    rc = tcb_time_train_steps(m->ops, self, s->seq, &ctx, s->o->quick ? QUICK_MAX_STEPS : MAX_STEPS, 0.8 * share, &t,
-                              err);
-    if (!rc) rc = tcb_time_eval_pairs(m->ops, self, s->seq, pairs, &method_s, &score_s, err);
+    int units = n_units(m->ops), steps = has_steps(m->ops);
+    double part = 0.8 * share / (steps + units);
+    if (steps) rc = measure_steps(s, m, self, t_index, part, err);
+    for (int k = 0; !rc && k < units; k++) rc = measure_unit(s, m, self, k, part, err);
     m->ops->destroy(self);
-    if (!rc) rc = add(s->cal, TCB_COST_STEP, m, t.step_s, t.steps, err);
-    if (!rc) rc = add(s->cal, TCB_COST_EVAL_PAIR, m, method_s, pairs, err);
-    if (rc) return rc;
-    s->score_s[t_index] += score_s * pairs, s->score_n[t_index] += pairs;
-    fprintf(s->out, "%9.1f ms/step (%2d steps after a %.1f s warm-up) %8.1f ms/pair\n", t.step_s * 1e3, t.steps,
-            t.first_s, method_s * 1e3);
-    return TCB_OK;
+    if (!rc) fprintf(s->out, "\n");
+    return rc;
 }
 
 static int thread_index(const tcb_calibrate_opts *o, int threads)
@@ -119,18 +176,19 @@ static int measure_all(const session *s, const measurement *m, int n, tcb_error 
     double t0 = tcb_now_seconds();
     for (int k = 0; k < n; k++) {
         double left = s->o->budget_s - (tcb_now_seconds() - t0);
-        fprintf(s->out, "[%2d/%d] %-9s %-6s %2d thread%s ", k + 1, n, m[k].ops->name, m[k].preset, m[k].threads,
+        fprintf(s->out, "[%2d/%d] %-9s %-6s %2d thread%s", k + 1, n, m[k].ops->name, m[k].preset, m[k].threads,
                 m[k].threads == 1 ? " " : "s");
         fflush(s->out);
         int rc = measure(s, &m[k], thread_index(s->o, m[k].threads), left / (n - k), err);
         if (rc) {
             fprintf(s->out, "failed\n");
-            tcb_error_prefix(err, "calibrate %s preset %s, %d threads: ", m[k].ops->name, m[k].preset, m[k].threads);
+            tcb_error_prefix(err, "calibrate %s%s%s, %d threads: ", m[k].ops->name, m[k].preset[0] ? " preset " : "",
+                             m[k].preset, m[k].threads);
             return rc;
         }
     }
     for (int t = 0; t < s->o->n_threads; t++) {
-        tcb_cost_entry e = {TCB_COST_SCORE_PAIR, "", "", s->o->threads[t], s->score_n[t], 0};
+        tcb_cost_entry e = {TCB_COST_SCORE_PAIR, "", "", s->o->threads[t], s->score_n[t], 0, "", 0};
         e.seconds = s->score_n[t] ? s->score_s[t] / s->score_n[t] : 0;
         int rc = s->score_n[t] ? tcb_calibration_add(s->cal, &e, err) : TCB_OK;
         if (rc) return rc;
@@ -161,7 +219,8 @@ static int merge_earlier(const char *path, tcb_calibration *cal, FILE *out, tcb_
     if (!tcb_is_file(path) || tcb_read_file(path, &text, &len, &ignored)) return TCB_OK;
     int rc = tcb_calibration_parse(text, path, &old, &ignored);
     free(text);
-    if (rc || !same_machine(old.machine, cal->machine) || old.n_verts != cal->n_verts) {
+    if (rc || !same_machine(old.machine, cal->machine) || old.n_verts != cal->n_verts ||
+        old.n_frames != cal->n_frames) {
         if (!rc) fprintf(out, "replacing %s (made on %s)\n", path, old.machine);
         if (!rc) tcb_calibration_free(&old);
         return TCB_OK;
@@ -173,7 +232,7 @@ static int merge_earlier(const char *path, tcb_calibration *cal, FILE *out, tcb_
         for (int q = 0; q < measured && !again; q++) {
             const tcb_cost_entry *f = &cal->entries[q];
             again = f->kind == e->kind && f->threads == e->threads && !strcmp(f->method, e->method) &&
-                    !strcmp(f->preset, e->preset);
+                    !strcmp(f->preset, e->preset) && !strcmp(f->unit, e->unit);
         }
         if (!again) rc = tcb_calibration_add(cal, e, err);
     }
@@ -207,7 +266,7 @@ int tcb_calibrate(const tcb_calibrate_opts *o, FILE *out, tcb_error *err)
     if (!rc && !(cal.machine_json = tcb_machine_describe(cal.machine, sizeof cal.machine)))
         rc = tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
     if (!rc) {
-        cal.n_verts = seq.n_verts;
+        cal.n_verts = seq.n_verts, cal.n_frames = seq.n_frames;
         fprintf(out, "calibrating on %s: %d measurements in a budget of %.0f s (%s)\n", cal.machine, n, o->budget_s,
                 o->quick ? "quick: coarse" : "a warm-up step, then steps while the budget lasts");
     }

@@ -2,9 +2,13 @@
  *
  * {"format": "tcbench-calibration 1",
  *  "machine": {"summary": "CPU model, N cores", "cpu": ..., "cores": ..., ...},
- *  "sequence": {"name": "synth/quadruped_walk", "vertices": 1234},
+ *  "sequence": {"name": "synth/quadruped_walk", "vertices": 1234, "frames": 6},
  *  "costs": [{"kind": "step", "method": "cc", "preset": "paper", "threads": 2,
- *             "seconds": 2.9, "samples": 4}, ...]} */
+ *             "seconds": 2.9, "samples": 4},
+ *            {"kind": "unit", "method": "nricp", "preset": "", "unit": "assign", ...},
+ *            {"kind": "surface_frame", ..., "size": 100000}, ...]}
+ * "unit" is there for kind unit only, "size" for surface_frame only;
+ * "frames" may be absent (files older than it: TCB_CALIBRATION_FRAMES). */
 #include <stdlib.h>
 #include <string.h>
 
@@ -14,7 +18,8 @@
 
 #define FORMAT "tcbench-calibration 1"
 
-static const char *const kind_names[] = {"step", "eval_pair", "score_pair", NULL}; /* tcb_cost_kind */
+static const char *const kind_names[] = {"step", "eval_pair", "score_pair", "unit", "surface_frame",
+                                         NULL}; /* tcb_cost_kind */
 
 extern const char *const tcb_calibration_builtin_names[];
 extern const char *const tcb_calibration_builtin_texts[];
@@ -48,21 +53,39 @@ static int copy_str(const cJSON *o, const char *key, const char *where, char *ou
     return rc;
 }
 
+/* The keys only some kinds have: a unit's name, a surface frame's samples. */
+static int parse_kind_keys(const cJSON *o, const char *where, tcb_cost_entry *e, tcb_error *err)
+{
+    if (e->kind == TCB_COST_UNIT) return copy_str(o, "unit", where, e->unit, sizeof e->unit, err);
+    if (cJSON_GetObjectItemCaseSensitive(o, "unit"))
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.unit: only a cost of kind \"unit\" has one", where);
+    long long size = 0;
+    int surface = e->kind == TCB_COST_SURFACE_FRAME;
+    if (!surface && cJSON_GetObjectItemCaseSensitive(o, "size"))
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.size: only a cost of kind \"surface_frame\" has one", where);
+    int rc = surface ? tcb_json_int(o, "size", where, 1, 0, 1, 1 << 30, &size, err) : TCB_OK;
+    e->size = (int)size;
+    return rc;
+}
+
 static int parse_entry(const cJSON *o, const char *where, tcb_calibration *c, tcb_error *err)
 {
-    static const char *const keys[] = {"kind", "method", "preset", "threads", "seconds", "samples", NULL};
+    static const char *const keys[] = {"kind", "method", "preset", "unit", "threads", "seconds", "samples", "size",
+                                       NULL};
     tcb_cost_entry e = {0};
     int kind = 0;
     long long threads = 0, samples = 0;
     int rc = tcb_json_expect_keys(o, where, keys, err);
     if (!rc) rc = tcb_json_enum(o, "kind", where, 1, 0, kind_names, &kind, err);
+    e.kind = (tcb_cost_kind)kind;
     if (!rc) rc = copy_str(o, "method", where, e.method, sizeof e.method, err);
     if (!rc) rc = copy_str(o, "preset", where, e.preset, sizeof e.preset, err);
+    if (!rc) rc = parse_kind_keys(o, where, &e, err);
     if (!rc) rc = tcb_json_int(o, "threads", where, 1, 0, 1, 1 << 20, &threads, err);
     if (!rc) rc = tcb_json_num(o, "seconds", where, 1, 0, 1e-12, 1e9, &e.seconds, err);
     if (!rc) rc = tcb_json_int(o, "samples", where, 1, 0, 1, 1 << 30, &samples, err);
     if (rc) return rc;
-    e.kind = (tcb_cost_kind)kind, e.threads = (int)threads, e.samples = (int)samples;
+    e.threads = (int)threads, e.samples = (int)samples;
     return tcb_calibration_add(c, &e, err);
 }
 
@@ -70,7 +93,7 @@ static int parse_header(const cJSON *root, const char *origin, tcb_calibration *
 {
     static const char *const keys[] = {"format", "machine", "sequence", "costs", NULL};
     const char *format;
-    long long nv = 0;
+    long long nv = 0, frames = 0;
     char where[4200];
     int rc = tcb_json_expect_keys(root, origin, keys, err);
     if (!rc) rc = tcb_json_str(root, "format", origin, 1, NULL, &format, err);
@@ -84,8 +107,9 @@ static int parse_header(const cJSON *root, const char *origin, tcb_calibration *
     snprintf(where, sizeof where, "%s: sequence", origin);
     if (!rc) rc = tcb_json_expect_object(seq, where, err);
     if (!rc) rc = tcb_json_int(seq, "vertices", where, 1, 0, 1, 100000000, &nv, err);
+    if (!rc) rc = tcb_json_int(seq, "frames", where, 0, TCB_CALIBRATION_FRAMES, 1, 100000000, &frames, err);
     if (rc) return rc;
-    c->n_verts = (int)nv;
+    c->n_verts = (int)nv, c->n_frames = (int)frames;
     if (!(c->machine_json = cJSON_PrintUnformatted(machine))) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
     return TCB_OK;
 }
@@ -130,9 +154,11 @@ static cJSON *entry_json(const tcb_cost_entry *e)
     cJSON_AddStringToObject(o, "kind", kind_names[e->kind]);
     cJSON_AddStringToObject(o, "method", e->method);
     cJSON_AddStringToObject(o, "preset", e->preset);
+    if (e->kind == TCB_COST_UNIT) cJSON_AddStringToObject(o, "unit", e->unit);
     cJSON_AddNumberToObject(o, "threads", e->threads);
     cJSON_AddNumberToObject(o, "seconds", significant(e->seconds));
     cJSON_AddNumberToObject(o, "samples", e->samples);
+    if (e->kind == TCB_COST_SURFACE_FRAME) cJSON_AddNumberToObject(o, "size", e->size);
     return o;
 }
 
@@ -146,6 +172,7 @@ int tcb_calibration_write(const tcb_calibration *c, const char *path, tcb_error 
         cJSON_AddItemToObject(root, "machine", machine);
         cJSON_AddStringToObject(seq, "name", "synth/quadruped_walk");
         cJSON_AddNumberToObject(seq, "vertices", c->n_verts);
+        cJSON_AddNumberToObject(seq, "frames", c->n_frames);
         cJSON_AddItemToObject(root, "sequence", seq);
         cJSON_AddItemToObject(root, "costs", costs);
         machine = seq = NULL;

@@ -540,7 +540,8 @@ static int cmd_calibrate(const cli *c)
     const char *out = c->value[F_OUT] ? c->value[F_OUT] : user;
     if (!out[0]) return usage_error("calibrate", "neither HOME nor XDG_CONFIG_HOME is set: give --out FILE");
     tcb_calibrate_opts o = {threads, n, c->value[F_ONLY], c->value[F_PRESET],
-                            (double)flag_int(c, F_BUDGET, c->set[F_QUICK] ? 60 : 600), c->set[F_QUICK], out};
+                            (double)flag_int(c, F_BUDGET, c->set[F_QUICK] ? 60 : 600), c->set[F_QUICK],
+                            (int)flag_int(c, F_SAMPLES, TCB_DEFAULT_SURFACE_SAMPLES), out};
     tcb_error err = {0};
     return tcb_calibrate(&o, stdout, &err) ? fail(&err) : 0;
 }
@@ -856,17 +857,19 @@ static const command commands[] = {
      "      --pred results.npz --name my_method\n"
      "  tcbench score configs/quick.json --dataset synth --sequence quadruped_walk \\\n"
      "      --pred predictions/ --name my_method\n"},
-    {"calibrate", cmd_calibrate, BIT(F_QUICK) | BIT(F_THREADS) | BIT(F_ONLY) | BIT(F_PRESET) | BIT(F_BUDGET) | BIT(F_OUT),
-     0, 0, "",
+    {"calibrate", cmd_calibrate,
+     BIT(F_QUICK) | BIT(F_THREADS) | BIT(F_ONLY) | BIT(F_PRESET) | BIT(F_BUDGET) | BIT(F_SAMPLES) | BIT(F_OUT), 0, 0, "",
      "usage: tcbench calibrate [--quick] [--threads T,T,...] [--only METHOD] [--preset NAME]\n"
-     "                         [--budget SECONDS] [--out FILE]\n"
+     "                         [--budget SECONDS] [--samples N] [--out FILE]\n"
      "\n"
      "Measures on this machine what 'tcbench run --dry-run' prices cells with: a training\n"
      "step of every trained method at each of its presets, the method's part of an\n"
-     "evaluation pair, and the harness's scoring of a pair, at each thread count; and\n"
-     "writes them with the machine's description (CPU, cores, library versions). Each\n"
-     "measurement is a warm-up step, then steps while its share of the budget lasts (at\n"
-     "least one: the largest presets may overrun a small budget, which the last line says).\n"
+     "evaluation pair, the reconstruction metrics of a frame (methods with a surface), the\n"
+     "units a method names (nricp: a registration, an assignment; neupig: its template),\n"
+     "and the harness's scoring of a pair, at each thread count; and writes them with the\n"
+     "machine's description (CPU, cores, library versions). Each measurement is a warm-up\n"
+     "step, then steps while its share of the budget lasts (at least one: the largest\n"
+     "presets may overrun a small budget, which the last line says); a unit likewise.\n"
      "\n"
      "The dry run reads, first match wins: <run dir>/calibration.json (a calibration made\n"
      "on the nodes that run it: --out RUN_DIR/calibration.json in a job there), the user's\n"
@@ -881,6 +884,8 @@ static const command commands[] = {
      "  --only METHOD  measure this method only\n"
      "  --preset NAME  measure this preset only\n"
      "  --budget S     seconds for the whole measurement (default 600; --quick 60)\n"
+     "  --samples N    surface samples per mesh of the reconstruction metrics measured\n"
+     "                 (default 100000, as evaluation.surface_samples; the dry run scales)\n"
      "  --out FILE     where to write (default $XDG_CONFIG_HOME/tcbench/calibration.json,\n"
      "                 else ~/.config/tcbench/calibration.json)\n"
      "\n"

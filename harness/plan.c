@@ -89,7 +89,7 @@ static void cell_state(const char *run_dir, const tcb_dataset_spec *d, const cha
 }
 
 static void estimate_cell(const tcb_calibration_set *cals, const tcb_method_spec *m, const tcb_cost_query *q,
-                          tcb_cost_estimate *e)
+                          int surface_samples, tcb_cost_estimate *e)
 {
     const tcb_method_ops *ops = tcb_registry_find(m->method); /* checked before */
     void *self = NULL;
@@ -100,7 +100,7 @@ static void estimate_cell(const tcb_calibration_set *cals, const tcb_method_spec
     if (ops->abi_version < 2 || !ops->estimate || ops->create(m->params_json, &self, &err)) return;
     ops->estimate(self, q, e);
     ops->destroy(self);
-    tcb_cost_price_cell(cals, ops->name, q, e);
+    tcb_cost_price_cell(cals, ops->name, q, tcb_method_has_surface(ops) ? surface_samples : 0, e);
 }
 
 /* The wall time of the cells' seconds run as `tasks` concurrent one-cell
@@ -173,7 +173,7 @@ static int plan_cell(void *ctx, const tcb_grid_cell *c)
     if (w->current != c->sequence) sequence_header(w, c->dataset, c->sequence->name);
     w->current = c->sequence;
     tcb_cost_estimate e;
-    estimate_cell(w->cals, c->method, &w->q, &e);
+    estimate_cell(w->cals, c->method, &w->q, w->cfg->surface_samples, &e);
     char state[TCB_PATH_MAX];
     cell_state(w->run_dir, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state);
     int runs = w->opts->force || !strcmp(state, "missing") || !strcmp(state, "unreadable") || !strcmp(state, "failed");

@@ -1,6 +1,6 @@
-/* Timing a method's training steps and evaluation pairs
- * (harness/calibration.h): the one measurement `tcbench calibrate` and
- * bench_train_step both make. */
+/* Timing a method's training steps, units, evaluation pairs and
+ * reconstruction metrics (harness/calibration.h): the measurements
+ * `tcbench calibrate` makes, the steps' also bench_train_step's. */
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
@@ -10,11 +10,9 @@
 #include "tcb/metrics.h"
 #include "tcb/synth.h"
 
-enum { CALIBRATION_FRAMES = 6 };
-
 int tcb_calibration_sequence(tcb_sequence *s, tcb_error *err)
 {
-    int rc = tcb_synth_generate("quadruped_walk", 1, CALIBRATION_FRAMES, s, err);
+    int rc = tcb_synth_generate("quadruped_walk", 1, TCB_CALIBRATION_FRAMES, s, err);
     if (!rc) rc = tcb_sequence_normalize(s, TCB_NORM_FIRST_FRAME, err);
     if (!rc) rc = tcb_sequence_sample_pools(s, TCB_DEFAULT_POOL_SIZE, 1, err);
     if (rc) {
@@ -25,20 +23,81 @@ int tcb_calibration_sequence(tcb_sequence *s, tcb_error *err)
     return TCB_OK;
 }
 
-int tcb_time_train_steps(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx,
-                         int max_steps, double budget_s, tcb_step_timing *out, tcb_error *err)
+/* One call of what is timed. */
+typedef int (*timed_call)(const void *arg, tcb_error *err);
+
+/* An untimed first call (its seconds in first_s), then calls until max or
+ * until budget_s is spent, the first included, at least one. */
+static int time_calls(timed_call call, const void *arg, int max, double budget_s, tcb_step_timing *out,
+                      tcb_error *err)
 {
-    omp_set_num_threads(ctx->n_threads);
     double t0 = tcb_now_seconds();
-    int rc = ops->train_steps(self, seq, ctx, 1, err);
+    int rc = call(arg, err);
     double t1 = tcb_now_seconds(), spent = 0;
     out->first_s = t1 - t0, out->steps = 0;
-    while (!rc && out->steps < max_steps && (out->steps == 0 || out->first_s + spent < budget_s)) {
-        rc = ops->train_steps(self, seq, ctx, 1, err);
+    while (!rc && out->steps < max && (out->steps == 0 || out->first_s + spent < budget_s)) {
+        rc = call(arg, err);
         out->steps++;
         spent = tcb_now_seconds() - t1;
     }
     out->step_s = out->steps ? spent / out->steps : NAN;
+    return rc;
+}
+
+typedef struct method_call {
+    const tcb_method_ops *ops;
+    void *self;
+    const tcb_sequence *seq;
+    const tcb_fit_ctx *ctx;
+    int unit;
+} method_call;
+
+static int one_step(const void *arg, tcb_error *err)
+{
+    const method_call *c = arg;
+    return c->ops->train_steps(c->self, c->seq, c->ctx, 1, err);
+}
+
+static int one_unit(const void *arg, tcb_error *err)
+{
+    const method_call *c = arg;
+    return c->ops->run_unit(c->self, c->seq, c->ctx, c->unit, err);
+}
+
+int tcb_time_train_steps(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx,
+                         int max_steps, double budget_s, tcb_step_timing *out, tcb_error *err)
+{
+    omp_set_num_threads(ctx->n_threads);
+    const method_call c = {ops, self, seq, ctx, 0};
+    return time_calls(one_step, &c, max_steps, budget_s, out, err);
+}
+
+int tcb_time_unit(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, int unit,
+                  int max_runs, double budget_s, tcb_step_timing *out, tcb_error *err)
+{
+    omp_set_num_threads(ctx->n_threads);
+    const method_call c = {ops, self, seq, ctx, unit};
+    return time_calls(one_unit, &c, max_runs, budget_s, out, err);
+}
+
+int tcb_time_surface_frames(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, int n, int samples,
+                            double *frame_s, tcb_error *err)
+{
+    tcb_surface_samples s;
+    int rc = tcb_surface_samples_init(&s, samples, err);
+    double t0 = 0;
+    /* frame -1 (frame 0, untimed) sets up what a cell's first frame does */
+    for (int k = -1; !rc && k < n; k++) {
+        int frame = (k + 1) % seq->n_frames;
+        tcb_rng rng, gt_rng;
+        tcb_rng_seed_stream(&rng, 0, "calibrate/surface");
+        tcb_rng_seed_stream(&gt_rng, 0, "calibrate/surface_gt");
+        tcb_surface_record rec;
+        if (k == 0) t0 = tcb_now_seconds();
+        rc = tcb_surface_frame_metrics(ops, self, seq, frame, &rng, &gt_rng, &s, &rec, err, err);
+    }
+    *frame_s = (tcb_now_seconds() - t0) / n;
+    tcb_surface_samples_free(&s);
     return rc;
 }
 

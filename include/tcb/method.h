@@ -42,10 +42,12 @@ extern "C" {
 
 /* 2 added `estimate`, 3 `surface`, 4 `prepare_pairs` and the reconstruct
  * that declines (TCB_ERR_UNSUPPORTED), 5 `presets`, `train_steps` and the
- * estimate priced by calibrated costs (tcb_cost_estimate.steps, .preset);
- * tables of older versions still load, and the harness reads no member
- * their version did not have (their tables end before it). */
-#define TCB_METHOD_ABI_VERSION 5
+ * estimate priced by calibrated costs (tcb_cost_estimate.steps, .preset),
+ * 6 `units`, `run_unit`, the estimate's unit counts (.units, .n_units) and
+ * steps that grow with the frame count (.step_frames); tables of older
+ * versions still load, and the harness reads no member their version did
+ * not have (their tables end before it; the estimate it zeroes). */
+#define TCB_METHOD_ABI_VERSION 6
 #define TCB_METHOD_ABI_OLDEST 1
 
 typedef struct tcb_fit_ctx {
@@ -91,11 +93,32 @@ typedef struct tcb_cost_query {
  * preset, the cell's threads). The harness clears both before the call;
  * a method whose configuration no preset prices leaves preset empty and
  * says why in basis, with fit_s and eval_s negative. */
+typedef struct tcb_unit_use {
+    char unit[32];          /* one of the method's `units` */
+    double fit, eval;       /* how many a fit and a cell's evaluation run */
+    double exponent;        /* a unit costs (vertices / the calibration sequence's)^exponent
+                             * times what calibrate measured */
+    int threads;            /* the threads each runs with: 0 the cell's (priced at the
+                             * cell's count), 1 one (a method running units side by side
+                             * divides its counts by its threads itself) */
+} tcb_unit_use;
+
+#define TCB_MAX_UNIT_USES 4
+
 typedef struct tcb_cost_estimate {
     double fit_s, eval_s;
     char basis[200];        /* "40 000 steps x 63.5 ms (bench_train_step, 1 thread)" */
     long long steps;        /* abi_version >= 5: training steps of a fit */
     char preset[32];        /* abi_version >= 5: the calibrated preset pricing them; "" none */
+    /* abi_version >= 6. A step's cost grows with the frame count (an epoch
+     * over every frame): priced x q->n_frames / the calibration sequence's. */
+    int step_frames;
+    /* abi_version >= 6: the method's measured units a cell runs (of
+     * `preset`, or of "" for a method without presets), added by the
+     * harness to fit_s and eval_s, which the method leaves at what the
+     * units do not cover (0 when they cover everything). */
+    int n_units;
+    tcb_unit_use units[TCB_MAX_UNIT_USES];
 } tcb_cost_estimate;
 
 /* A method's surface of one frame as a triangle mesh parametrised by
@@ -200,6 +223,18 @@ typedef struct tcb_method_ops {
      * is fitted with the weights of the steps done, so that transfer and
      * reconstruct can be timed on seq too. */
     int (*train_steps)(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, long long n, tcb_error *err);
+
+    /* Optional (NULL: none; read only from tables of abi_version >= 6).
+     * Named costs besides the training step that `tcbench calibrate`
+     * measures, NULL-terminated ("register_random": one registration
+     * between the frames of a random pair), at each preset (a method
+     * without presets: created with "{}", preset "") and thread count; the
+     * estimate counts them (tcb_cost_estimate.units). run_unit runs one of
+     * units[unit] on seq, on a created method (fitted or not: it prepares
+     * what it needs, and the caller runs it once untimed first) with the
+     * caller's OpenMP thread count; the caller times the calls. */
+    const char *const *units;
+    int (*run_unit)(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, int unit, tcb_error *err);
 } tcb_method_ops;
 
 typedef const tcb_method_ops *const *(*tcb_plugin_entry_fn)(int *count);

@@ -36,6 +36,7 @@
 #include "methods/neupig/prepare.h"
 #include "methods/neupig/train.h"
 #include "methods/params.h"
+#include "methods/step_cost.h"
 #include "neural/train_loop.h"
 #include "neural/weights.h"
 #include "tcb/geodesic.h"
@@ -60,6 +61,14 @@ static const neupig_preset presets[] = {
 };
 static const char *const preset_names[] = {"paper", "fast", "cpu", "tiny", NULL};
 static const char *const normals_names[] = {"estimated", "gt", NULL};
+/* The presets `tcbench calibrate` measures: fast has paper's sizes (its
+ * epochs cost what paper's do), so paper's step prices it. */
+static const char *const calibrated_presets[] = {"paper", "cpu", "tiny", NULL};
+static const char *const unit_names[] = {"template", NULL};
+enum { UNIT_TEMPLATE };
+#define DEFAULT_RECON_POINTS 2500
+
+struct steps;
 
 typedef struct neupig_method {
     tcb_neupig_arch arch;
@@ -73,6 +82,7 @@ typedef struct neupig_method {
     tcb_mesh template_mesh;        /* in the cube */
     float *deformed;               /* [T][nv][3] the template in every frame, in the cube */
     int n_frames;
+    struct steps *steps;           /* train_steps' training; NULL: none */
 } neupig_method;
 
 static int parse(const char *params_json, void *obj, tcb_error *err)
@@ -98,7 +108,7 @@ static int parse(const char *params_json, void *obj, tcb_error *err)
     if (!rc) rc = tcb_json_int(j, "levels", where, 0, p->levels, 1, TCB_NEUPIG_MAX_LEVELS, &levels, err);
     if (!rc) rc = tcb_json_int(j, "features", where, 0, p->features, 1, 4096, &features, err);
     if (!rc) rc = tcb_json_int(j, "hidden", where, 0, p->hidden, 1, 65536, &hidden, err);
-    if (!rc) rc = tcb_json_int(j, "recon_points", where, 0, 2500, 1, 10000000, &recon, err);
+    if (!rc) rc = tcb_json_int(j, "recon_points", where, 0, DEFAULT_RECON_POINTS, 1, 10000000, &recon, err);
     if (!rc) rc = tcb_json_int(j, "checkpoint_every", where, 0, 50, 0, 100000000, &m->checkpoint_every, err);
     if (!rc) rc = tcb_json_num(j, "divergence", where, 0, 1e4, 0, 1e300, &m->sched.divergence, err);
     cJSON_Delete(j);
@@ -123,10 +133,13 @@ static int create(const char *params_json, void **self, tcb_error *err)
     return tcb_method_create(sizeof(neupig_method), "neupig", params_json, parse, NULL, self, err);
 }
 
+static void steps_free(neupig_method *m);
+
 static void destroy(void *self)
 {
     neupig_method *m = self;
     if (!m) return;
+    steps_free(m);
     release_model(m);
     free(m);
 }
@@ -306,6 +319,7 @@ static int fit_load(void *f, const char *path, double *seconds, tcb_error *err)
 static int fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_error *err)
 {
     neupig_method *m = self;
+    steps_free(m);
     release_model(m);
     m->seed = ctx->seed;
     inputs in;
@@ -351,12 +365,15 @@ static void unmap(const neupig_method *m, float *pts, int n)
     for (size_t i = 0; i < 3 * (size_t)n; i++) pts[i] = (float)(pts[i] / m->map.scale + m->map.centre[i % 3]);
 }
 
+static int steps_model(neupig_method *m, tcb_error *err);
+
 static int transfer(void *self, const tcb_sequence *seq, int i, int j, const float *src, int n, float *out,
                     tcb_rng *rng, tcb_error *err)
 {
     (void)rng;
     neupig_method *m = self;
-    int rc = check_frames(m, seq, i, j, err);
+    int rc = steps_model(m, err);
+    if (!rc) rc = check_frames(m, seq, i, j, err);
     if (rc) return rc;
     const tcb_mesh *t = &m->template_mesh;
     tcb_surface_point *loc = malloc((size_t)n * sizeof *loc);
@@ -376,7 +393,8 @@ static int reconstruct(void *self, const tcb_sequence *seq, int i, int j, int fr
 {
     neupig_method *m = self;
     *pts = NULL;
-    int rc = check_frames(m, seq, i, j, err);
+    int rc = steps_model(m, err);
+    if (!rc) rc = check_frames(m, seq, i, j, err);
     if (rc) return rc;
     const tcb_mesh *t = &m->template_mesh;
     if (!(*pts = malloc((size_t)m->recon_points * 3 * sizeof **pts)))
@@ -432,6 +450,7 @@ static int save(void *self, const char *path, tcb_error *err)
 static int load(void *self, const tcb_sequence *seq, const char *path, tcb_error *err)
 {
     neupig_method *m = self;
+    steps_free(m);
     release_model(m);
     size_t n = n_params_of(m, err);
     if (!n) return err->code;
@@ -451,6 +470,103 @@ static int load(void *self, const tcb_sequence *seq, const char *path, tcb_error
     return rc;
 }
 
+/* ---- calibration (tcbench calibrate, the dry run) ---- */
+
+/* tcb_method_ops.train_steps: fit's training (its inputs and template
+ * built by the first call) n epochs at a time; the fitted model follows
+ * from the epochs done when a transfer or reconstruct first asks
+ * (steps_model), so that the timed calls are epochs only. */
+struct steps {
+    inputs in;
+    fit_state s;
+};
+
+static void steps_free(neupig_method *m)
+{
+    if (!m->steps) return;
+    tcb_neupig_trainer_free(&m->steps->s.trainer);
+    inputs_free(&m->steps->in);
+    free(m->steps);
+    m->steps = NULL;
+}
+
+static int train_steps(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, long long n, tcb_error *err)
+{
+    neupig_method *m = self;
+    int rc = TCB_OK;
+    if (!m->steps) {
+        release_model(m);
+        m->seed = ctx->seed;
+        if (!(m->steps = calloc(1, sizeof *m->steps))) return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+        m->steps->s.seed = ctx->seed;
+        rc = prepare(m, seq, ctx->seed, &m->steps->in, err);
+        if (!rc)
+            rc = tcb_neupig_trainer_init(&m->steps->s.trainer, &m->arch, &m->sched, &m->steps->in.problem, ctx->seed,
+                                         err);
+        if (rc) steps_free(m);
+    }
+    double loss;
+    for (long long k = 0; !rc && k < n; k++) rc = tcb_neupig_train_step(&m->steps->s.trainer, &loss, err);
+    free(m->deformed), free(m->params);
+    m->deformed = NULL, m->params = NULL; /* the model of fewer epochs */
+    return rc;
+}
+
+/* The model of train_steps' epochs, once they stopped; nothing without. */
+static int steps_model(neupig_method *m, tcb_error *err)
+{
+    if (!m->steps || m->deformed) return TCB_OK;
+    const tcb_neupig_trainer *t = &m->steps->s.trainer;
+    if (!(m->params = malloc(t->model.n_params * sizeof *m->params)))
+        return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    memcpy(m->params, t->params, t->model.n_params * sizeof *m->params);
+    return deform_all(m, &m->steps->in, err);
+}
+
+/* tcb_method_ops.run_unit: "template", the inputs and template mesh a fit
+ * (and a load) builds before its first epoch: the clouds, the keyframe,
+ * its screened Poisson surface and the decimation. Built on a copy, so that
+ * a training of train_steps keeps its own. */
+static int run_unit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, int unit, tcb_error *err)
+{
+    if (unit != UNIT_TEMPLATE) return tcb_fail(err, TCB_ERR_INTERNAL, "neupig: no unit %d", unit);
+    neupig_method scratch = *(const neupig_method *)self;
+    scratch.template_mesh = (tcb_mesh){0, 0, NULL, NULL};
+    inputs in;
+    int rc = prepare(&scratch, seq, ctx->seed, &in, err);
+    inputs_free(&in);
+    tcb_mesh_free(&scratch.template_mesh);
+    return rc;
+}
+
+/* The calibrated preset of m's sizes; -1 when one differs from each. */
+static int calibrated_preset(const neupig_method *m)
+{
+    for (int k = 0; calibrated_presets[k]; k++) {
+        int pi = 0;
+        while (strcmp(preset_names[pi], calibrated_presets[k])) pi++;
+        const neupig_preset *p = &presets[pi];
+        if (m->points == p->points && m->template_faces == p->template_faces &&
+            m->poisson_depth == p->poisson_depth && m->arch.levels == p->levels && m->arch.features == p->features &&
+            m->arch.hidden == p->hidden && m->recon_points == DEFAULT_RECON_POINTS)
+            return k;
+    }
+    return -1;
+}
+
+/* A fit: its epochs (each over every frame: step_frames), after the
+ * template, which a fit builds once (its Poisson surface at depth 10 is
+ * seconds). */
+static void estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out)
+{
+    (void)q;
+    const neupig_method *m = self;
+    int k = calibrated_preset(m);
+    tcb_step_cost_estimate("neupig", calibrated_presets, k, m->sched.epochs, out);
+    out->step_frames = 1;
+    if (k >= 0) out->units[out->n_units++] = (tcb_unit_use){"template", 1, 0, 0, 0};
+}
+
 const tcb_method_ops tcb_method_neupig = {
     .abi_version = TCB_METHOD_ABI_VERSION,
     .name = "neupig",
@@ -463,4 +579,9 @@ const tcb_method_ops tcb_method_neupig = {
     .save = save,
     .load = load,
     .destroy = destroy,
+    .estimate = estimate,
+    .presets = calibrated_presets,
+    .train_steps = train_steps,
+    .units = unit_names,
+    .run_unit = run_unit,
 };

@@ -35,6 +35,15 @@ static double *sq_dist_matrix(const float *moved, const float *target, int n)
     return cost;
 }
 
+int nricp_assign(const float *moved, const float *target, int n, int32_t *map, tcb_error *err)
+{
+    double *cost = sq_dist_matrix(moved, target, n);
+    int rc = cost ? tcb_lap_solve(cost, n, n, map, NULL, err)
+                  : tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory for a %d x %d cost matrix", n, n);
+    free(cost);
+    return rc;
+}
+
 /* map = c_{a→b}: register frame a onto frame b, then match; the identity
  * across a block boundary (no chain uses it). */
 static int one_map(const nricp_method *m, const tcb_sequence *seq, int a, int b, int32_t *map,
@@ -52,12 +61,7 @@ static int one_map(const nricp_method *m, const tcb_sequence *seq, int a, int b,
     if (!moved) return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory");
     int rc = nricp_register(pa, na, nv, pb, nb, nv, &m->params, moved, err);
     if (!rc && m->strategy == NRICP_SIMPLE) rc = tcb_nn_nearest(pb, nv, moved, nv, map, NULL, err);
-    if (!rc && m->strategy == NRICP_BIJECTIVE) {
-        double *cost = sq_dist_matrix(moved, pb, nv);
-        rc = cost ? tcb_lap_solve(cost, nv, nv, map, NULL, err)
-                  : tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory for a %d x %d cost matrix", nv, nv);
-        free(cost);
-    }
+    if (!rc && m->strategy == NRICP_BIJECTIVE) rc = nricp_assign(moved, pb, nv, map, err);
     free(moved);
     if (rc) tcb_error_prefix(err, "map frame %d -> %d: ", a, b);
     return rc;

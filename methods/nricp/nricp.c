@@ -17,7 +17,6 @@
 
 #include "methods/builtin.h"
 #include "methods/nricp/nricp_internal.h"
-#include <math.h>
 #include <stdio.h>
 
 #include "methods/params.h"
@@ -150,46 +149,67 @@ static int nricp_transfer(void *self, const tcb_sequence *seq, int i, int j, con
     return tcb_fail(err, TCB_ERR_INTERNAL, "nricp: unknown strategy %d", (int)m->strategy);
 }
 
-/* Seconds one registration of n points takes per point and round, one
- * thread, Zen 4, measured on crane (10 002 vertices, 25 rounds): 2.9 s
- * between the frames of a random pair (the random strategy's evaluation,
- * 1489 s for 500 pairs), 0.40 s between consecutive frames, which start
- * closer (propagate_simple's fit, 138 s for 348 maps, the other core
- * idle), and 0.50 s for a deform chain's step (propagate_deform's
- * evaluation, 16 482 steps in 4136 s on two threads, both cores busy). */
-#define REG_RANDOM_S (2.9 / (10002.0 * 25))
-#define REG_NEIGHBOR_S (0.40 / (10002.0 * 25))
-#define REG_CHAIN_S (0.50 / (10002.0 * 25))
-/* One dense assignment between consecutive frames of n points: bench_lap's
- * squared-distance costs, 1.7 s at n = 4000, growing as n^2.3. */
-static double lap_seconds(int n) { return 1.7 * pow(n / 4000.0, 2.3); }
+/* The costs `tcbench calibrate` measures (tcb_method_ops.units), with the
+ * default params, on its sequence: a registration between the frames of
+ * a random pair (frames 0 and F/2: a random pair's frames lie F/3 apart
+ * on average, further than consecutive ones, and registrations between
+ * frames further apart take longer), one between consecutive frames (a
+ * propagating map's; a deform chain's step, which starts from the
+ * deformed previous frame, is priced as one), and the dense assignment of
+ * a frame's vertices to the next's (propagate_bijective's matching). */
+static const char *const unit_names[] = {"register_random", "register_neighbor", "assign", NULL};
+enum { UNIT_RANDOM, UNIT_NEIGHBOR, UNIT_ASSIGN };
+/* A registration costs about its points x rounds (the old typed-in model,
+ * crane against the synthetic walk); an assignment grows as n^2.3
+ * (bench_lap's squared-distance costs). */
+#define REGISTER_EXPONENT 1.0
+#define ASSIGN_EXPONENT 2.3
 
+static int nricp_run_unit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, int unit, tcb_error *err)
+{
+    (void)ctx; /* one registration or assignment runs on one thread */
+    nricp_method *m = self;
+    int rc = m->normals && m->n_frames == seq->n_frames && m->n_verts == seq->n_verts ? TCB_OK
+                                                                                      : nricp_prepare(m, seq, err);
+    int nv = seq->n_verts, b = unit == UNIT_RANDOM ? seq->n_frames / 2 : 1;
+    float *out = rc ? NULL : malloc((size_t)nv * 3 * sizeof *out);
+    int32_t *map = rc ? NULL : malloc((size_t)nv * sizeof *map);
+    if (!rc && (!out || !map)) rc = tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory");
+    if (!rc && unit == UNIT_ASSIGN) rc = nricp_assign(tcb_seq_frame(seq, 0), tcb_seq_frame(seq, 1), nv, map, err);
+    else if (!rc)
+        rc = nricp_register(tcb_seq_frame(seq, 0), nricp_normals_of(m, 0), nv, tcb_seq_frame(seq, b),
+                            nricp_normals_of(m, b), nv, &m->params, out, err);
+    free(out), free(map);
+    return rc;
+}
+
+/* The units a cell runs: the maps (registrations, and for bijective
+ * assignments) spread over the cell's threads (maps.c), as do a deform
+ * chain's steps (deform.c); random registers each pair, one after another.
+ * Registrations scale with the rounds over the default's. */
 static void nricp_estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out)
 {
     const nricp_method *m = self;
     const char *name = nricp_strategy_names[m->strategy];
-    out->fit_s = out->eval_s = -1;
     if (q->n_verts < 1 || q->n_frames < 2) {
+        out->fit_s = out->eval_s = -1;
         snprintf(out->basis, sizeof out->basis, "%s: grows with the vertex count (data absent)", name);
         return;
     }
-    double rounds = m->params.rounds, nv = q->n_verts, threads = q->n_threads > 1 ? q->n_threads : 1;
-    double neighbor = REG_NEIGHBOR_S * nv * rounds, maps = 2.0 * (q->n_frames - 1);
-    double rate = m->strategy == NRICP_RANDOM   ? REG_RANDOM_S * nv * rounds
-                  : m->strategy == NRICP_DEFORM ? REG_CHAIN_S * nv * rounds
-                                                : neighbor;
-    /* the maps (registration, and for bijective the assignment) spread
-     * over the cell's threads (maps.c) */
-    out->fit_s = nricp_uses_maps(m->strategy) ? maps * neighbor / threads : 0;
-    if (m->strategy == NRICP_BIJECTIVE) out->fit_s += maps * lap_seconds(q->n_verts) / threads;
-    /* random: one registration per pair; deform: the chains' steps
-     * (deform.c), the chains spread over the cell's threads */
-    out->eval_s = m->strategy == NRICP_RANDOM   ? q->n_pairs * rate
-                  : m->strategy == NRICP_DEFORM ? nricp_deform_expected_steps(q->n_frames, q->n_pairs) * rate / threads
-                                                : 0;
-    snprintf(out->basis, sizeof out->basis,
-             "%s: %.2f s per registration of %d points (crane-measured, per thread, Zen 4)", name, rate,
-             q->n_verts);
+    double rounds = (double)m->params.rounds / nricp_default_params().rounds;
+    double threads = q->n_threads > 1 ? q->n_threads : 1, maps = 2.0 * (q->n_frames - 1) / threads;
+    tcb_unit_use *u = out->units;
+    out->fit_s = out->eval_s = 0;
+    snprintf(out->basis, sizeof out->basis, "%s", name);
+    if (m->strategy == NRICP_RANDOM)
+        u[out->n_units++] = (tcb_unit_use){"register_random", 0, q->n_pairs * rounds, REGISTER_EXPONENT, 1};
+    if (nricp_uses_maps(m->strategy))
+        u[out->n_units++] = (tcb_unit_use){"register_neighbor", maps * rounds, 0, REGISTER_EXPONENT, 1};
+    if (m->strategy == NRICP_BIJECTIVE) u[out->n_units++] = (tcb_unit_use){"assign", maps, 0, ASSIGN_EXPONENT, 1};
+    if (m->strategy == NRICP_DEFORM)
+        u[out->n_units++] = (tcb_unit_use){"register_neighbor", 0,
+                                           nricp_deform_expected_steps(q->n_frames, q->n_pairs) * rounds / threads,
+                                           REGISTER_EXPONENT, 1};
 }
 
 static void nricp_destroy(void *self)
@@ -214,4 +234,6 @@ const tcb_method_ops tcb_method_nricp = {
     .destroy = nricp_destroy,
     .estimate = nricp_estimate,
     .prepare_pairs = nricp_prepare_pairs,
+    .units = unit_names,
+    .run_unit = nricp_run_unit,
 };

@@ -83,6 +83,9 @@ int nricp_prepare(nricp_method *m, const tcb_sequence *seq, tcb_error *err);
 int nricp_fit_maps(nricp_method *m, const tcb_sequence *seq, const tcb_fit_ctx *ctx,
                    tcb_error *err);
 void nricp_compose(const nricp_method *m, int i, int j, int32_t *idx);
+/* The exact linear assignment of n moved points to n target points on
+ * squared distances (propagate_bijective's matching): map [n]. */
+int nricp_assign(const float *moved, const float *target, int n, int32_t *map, tcb_error *err);
 
 /* deform.c: the chains of the n pairs (pairs[2p] → pairs[2p + 1]) into
  * m->chains, in parallel (ctx->n_threads), each saved in ctx->work_dir
