@@ -163,14 +163,15 @@ static int price_unit(const tcb_calibration_set *s, const char *method, const tc
 }
 
 /* The units' seconds added to fit_s and eval_s; the basis names the
- * costliest unit (after the steps' basis when there is one, else after the
- * method's own words). 0 when one is unknown. */
+ * costliest unit: after the steps' basis when there is one (which names
+ * the machine), else after the method's own words with its threads and
+ * machine. 0 when one is unknown. */
 static int price_units(const tcb_calibration_set *s, const char *method, const tcb_cost_query *q,
                        tcb_cost_estimate *e)
 {
     double most = -1;
     char costliest[192] = "";
-    int n = e->n_units < TCB_MAX_UNIT_USES ? e->n_units : TCB_MAX_UNIT_USES;
+    int n = e->n_units < TCB_MAX_UNIT_USES ? e->n_units : TCB_MAX_UNIT_USES, after_steps = e->basis[0] && e->steps;
     for (int k = 0; k < n; k++) {
         const tcb_unit_use *u = &e->units[k];
         double fit, eval;
@@ -181,12 +182,14 @@ static int price_units(const tcb_calibration_set *s, const char *method, const t
         char threads[64];
         most = fit + eval;
         threads_text(&p, u->threads > 0 ? u->threads : q->n_threads, threads, sizeof threads);
-        snprintf(costliest, sizeof costliest, "%.4g %.31s x %.3g s (%.40s, %.50s)", u->fit + u->eval, u->unit,
-                 fit + eval > 0 ? (fit + eval) / (u->fit + u->eval) : 0.0, threads, p.from->machine);
+        int len = snprintf(costliest, sizeof costliest, "%.4g %.31s x %.3g s", u->fit + u->eval, u->unit,
+                           fit + eval > 0 ? (fit + eval) / (u->fit + u->eval) : 0.0);
+        if (!after_steps && len > 0 && (size_t)len < sizeof costliest)
+            snprintf(costliest + len, sizeof costliest - (size_t)len, " (%.40s, %.50s)", threads, p.from->machine);
     }
     size_t len = strlen(e->basis);
     if (n && len + 4 < sizeof e->basis)
-        snprintf(e->basis + len, sizeof e->basis - len, "%s%s", len ? (e->steps ? " + " : ": ") : "", costliest);
+        snprintf(e->basis + len, sizeof e->basis - len, "%s%s", len ? (after_steps ? " + " : ": ") : "", costliest);
     return 1;
 }
 
