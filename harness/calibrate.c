@@ -4,14 +4,14 @@
  * Every registered method with train_steps or units, at each of its
  * presets (one without presets: once, created with "{}") and each thread
  * count asked, is one measurement. Its share of the budget (what is left,
- * over the measurements left) is split between its steps and each unit:
- * the steps are a warm-up step, then steps while their part lasts, at
- * least one and at most MAX_STEPS, then a few evaluation pairs, which also
- * time the harness's scoring, and the reconstruction metrics of a few
- * frames for a method with a surface; each unit is an untimed run, then
- * runs while its part lasts, at least one. A measurement whose warm-ups
- * and single runs exceed its share overruns the budget, which the closing
- * line says. */
+ * over the measurements left) is split between its steps, its surface
+ * frames and each unit: the steps are a warm-up step, then steps while
+ * their part lasts, at least one and at most MAX_STEPS, then a few
+ * evaluation pairs, which also time the harness's scoring; for a method
+ * with a surface the reconstruction metrics of frames while their part
+ * lasts, at least one; each unit is an untimed run, then runs while its
+ * part lasts, at least one. A measurement whose warm-ups and single runs
+ * exceed its share overruns the budget, which the closing line says. */
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -105,8 +105,27 @@ static int add(tcb_calibration *cal, tcb_cost_kind kind, const measurement *m, d
     return tcb_calibration_add(cal, &e, err);
 }
 
-/* The steps, the evaluation pairs and, for a method with a surface, the
- * reconstruction metrics of a few frames; the pairs' scoring summed into
+static int surface_measured(const session *s, const measurement *m)
+{
+    return tcb_method_has_surface(m->ops) && s->o->surface_samples > 0;
+}
+
+/* The reconstruction metrics of a few frames (a method with a surface). */
+static int measure_surface(const session *s, const measurement *m, void *self, double budget_s, tcb_error *err)
+{
+    tcb_step_timing t;
+    double mesh_s;
+    int rc = tcb_time_surface_frames(m->ops, self, s->seq, s->o->quick ? QUICK_SURFACE_FRAMES : SURFACE_FRAMES,
+                                     budget_s, s->o->surface_samples, &t, &mesh_s, err);
+    /* the harness's part scales with the samples, the method's surface not */
+    if (!rc && !(rc = add(s->cal, TCB_COST_SURFACE_FRAME, m, t.step_s, t.steps, err)))
+        s->cal->entries[s->cal->n - 1].size = s->o->surface_samples;
+    if (!rc) rc = add(s->cal, TCB_COST_SURFACE_MESH, m, mesh_s, t.steps, err);
+    if (!rc) fprintf(s->out, " %.2f s/surface frame (%.2f s its mesh)", t.step_s + mesh_s, mesh_s);
+    return rc;
+}
+
+/* The steps and the evaluation pairs; the pairs' scoring summed into
  * s->score_*[t_index]. */
 static int measure_steps(const session *s, const measurement *m, void *self, int t_index, double budget_s,
                          tcb_error *err)
@@ -114,22 +133,17 @@ static int measure_steps(const session *s, const measurement *m, void *self, int
     const tcb_calibrate_opts *o = s->o;
     tcb_fit_ctx ctx = {.seed = 0, .n_threads = m->threads};
     tcb_step_timing t;
-    double method_s = 0, score_s = 0, frame_s = 0;
-    int pairs = o->quick ? QUICK_EVAL_PAIRS : EVAL_PAIRS, frames = o->quick ? QUICK_SURFACE_FRAMES : SURFACE_FRAMES;
-    int surface = tcb_method_has_surface(m->ops) && o->surface_samples > 0;
+    double method_s = 0, score_s = 0;
+    int pairs = o->quick ? QUICK_EVAL_PAIRS : EVAL_PAIRS;
     int rc = tcb_time_train_steps(m->ops, self, s->seq, &ctx, o->quick ? QUICK_MAX_STEPS : MAX_STEPS, budget_s, &t,
                                   err);
     if (!rc) rc = tcb_time_eval_pairs(m->ops, self, s->seq, pairs, &method_s, &score_s, err);
-    if (!rc && surface) rc = tcb_time_surface_frames(m->ops, self, s->seq, frames, o->surface_samples, &frame_s, err);
     if (!rc) rc = add(s->cal, TCB_COST_STEP, m, t.step_s, t.steps, err);
     if (!rc) rc = add(s->cal, TCB_COST_EVAL_PAIR, m, method_s, pairs, err);
-    if (!rc && surface && !(rc = add(s->cal, TCB_COST_SURFACE_FRAME, m, frame_s, frames, err)))
-        s->cal->entries[s->cal->n - 1].size = o->surface_samples;
     if (rc) return rc;
     s->score_s[t_index] += score_s * pairs, s->score_n[t_index] += pairs;
     fprintf(s->out, "%9.1f ms/step (%2d steps after a %.1f s warm-up) %8.1f ms/pair", t.step_s * 1e3, t.steps,
             t.first_s, method_s * 1e3);
-    if (surface) fprintf(s->out, " %7.2f s/surface frame", frame_s);
     return TCB_OK;
 }
 
@@ -154,9 +168,10 @@ static int measure(const session *s, const measurement *m, int t_index, double s
     void *self;
     int rc = m->ops->create(params, &self, err);
     if (rc) return rc;
-    int units = n_units(m->ops), steps = has_steps(m->ops);
-    double part = 0.8 * share / (steps + units);
+    int units = n_units(m->ops), steps = has_steps(m->ops), surface = steps && surface_measured(s, m);
+    double part = 0.8 * share / (steps + surface + units);
     if (steps) rc = measure_steps(s, m, self, t_index, part, err);
+    if (!rc && surface) rc = measure_surface(s, m, self, part, err);
     for (int k = 0; !rc && k < units; k++) rc = measure_unit(s, m, self, k, part, err);
     m->ops->destroy(self);
     if (!rc) fprintf(s->out, "\n");

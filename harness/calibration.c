@@ -6,7 +6,8 @@
  *  "costs": [{"kind": "step", "method": "cc", "preset": "paper", "threads": 2,
  *             "seconds": 2.9, "samples": 4},
  *            {"kind": "unit", "method": "nricp", "preset": "", "unit": "assign", ...},
- *            {"kind": "surface_frame", ..., "size": 100000}, ...]}
+ *            {"kind": "surface_frame", ..., "size": 100000},
+ *            {"kind": "surface_mesh", ...}, ...]}
  * "unit" is there for kind unit only, "size" for surface_frame only;
  * "frames" may be absent (files older than it: TCB_CALIBRATION_FRAMES). */
 #include <stdlib.h>
@@ -19,7 +20,7 @@
 #define FORMAT "tcbench-calibration 1"
 
 static const char *const kind_names[] = {"step", "eval_pair", "score_pair", "unit", "surface_frame",
-                                         NULL}; /* tcb_cost_kind */
+                                         "surface_mesh", NULL}; /* tcb_cost_kind */
 
 extern const char *const tcb_calibration_builtin_names[];
 extern const char *const tcb_calibration_builtin_texts[];

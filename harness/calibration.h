@@ -10,8 +10,9 @@
  *   - one of a method's named units (kind unit: a registration, a template
  *     mesh; tcb_method_ops.units) at each preset,
  *   - the reconstruction metrics of one frame of a method with a surface:
- *     its surface, both sample sets and the metrics, at `size` samples per
- *     mesh (kind surface_frame),
+ *     the method's surface of the frame (kind surface_mesh), and the
+ *     harness's part, both sample sets and the metrics, at `size` samples
+ *     per mesh (kind surface_frame),
  *   - the harness's scoring of a pair: projection, metrics, geodesic error
  *     (kind score_pair, no method),
  * each at the thread counts measured, on the calibration sequence
@@ -30,6 +31,7 @@ typedef enum tcb_cost_kind {
     TCB_COST_SCORE_PAIR,
     TCB_COST_UNIT,
     TCB_COST_SURFACE_FRAME,
+    TCB_COST_SURFACE_MESH,
     TCB_COST_KINDS
 } tcb_cost_kind;
 
@@ -137,11 +139,13 @@ int tcb_time_train_steps(const tcb_method_ops *ops, void *self, const tcb_sequen
 int tcb_time_unit(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, int unit,
                   int max_runs, double budget_s, tcb_step_timing *out, tcb_error *err);
 
-/* Mean seconds of one frame's reconstruction metrics (the method's
- * surface, both sample sets of `samples` points, the metrics) over n
- * frames of seq, after one untimed, of a method trained by train_steps. */
-int tcb_time_surface_frames(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, int n, int samples,
-                            double *frame_s, tcb_error *err);
+/* Times the reconstruction metrics of a frame of a method trained by
+ * train_steps, on frames of seq until max_frames or until budget_s is
+ * spent, at least one, no warm-up (first_s 0): *mesh_s the mean of the
+ * method's surface, step_s the harness's part at `samples` per mesh (both
+ * sample sets and the metrics, on the GT meshes of two frames). */
+int tcb_time_surface_frames(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, int max_frames,
+                            double budget_s, int samples, tcb_step_timing *out, double *mesh_s, tcb_error *err);
 
 /* Mean seconds per pair over n pairs of seq, after one untimed, of a
  * method trained by train_steps: its part (transfer, reconstructions and their Chamfer

@@ -195,16 +195,19 @@ static int price_units(const tcb_calibration_set *s, const char *method, const t
 
 /* The reconstruction metrics of the frames q's pairs use (expected
  * distinct frames of 2 n_pairs uniform draws: clips' consecutive frames
- * use fewer), at `samples` per mesh; -1 unknown, -2 not measured. */
+ * use fewer): the method's surface of each and the harness's part at
+ * `samples` per mesh; -1 unknown, -2 not measured. */
 static double surface_seconds(const tcb_calibration_set *s, const char *method, const char *preset,
                               const tcb_cost_query *q, int samples)
 {
-    tcb_cost_price p;
-    const tcb_cost_key key = {TCB_COST_SURFACE_FRAME, method, preset, ""};
-    if (tcb_cost_lookup(s, &key, q->n_threads, &p)) return -2;
+    tcb_cost_price harness, mesh;
+    const tcb_cost_key frame_key = {TCB_COST_SURFACE_FRAME, method, preset, ""};
+    const tcb_cost_key mesh_key = {TCB_COST_SURFACE_MESH, method, preset, ""};
+    if (tcb_cost_lookup(s, &frame_key, q->n_threads, &harness) || tcb_cost_lookup(s, &mesh_key, q->n_threads, &mesh))
+        return -2;
     if (q->n_frames < 1) return -1;
     double f = q->n_frames, frames = f * (1 - pow(1 - 1 / f, 2.0 * q->n_pairs));
-    return frames * p.seconds * samples;
+    return frames * (mesh.seconds + harness.seconds * samples);
 }
 
 /* The reconstruction metrics added to eval_s; a method whose surface frame

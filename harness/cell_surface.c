@@ -11,18 +11,24 @@
 
 #include "harness/internal.h"
 
-void tcb_surface_samples_free(tcb_surface_samples *s)
+/* Scratch for one frame: the two sample sets and their normals. */
+typedef struct samples {
+    int n;
+    float *pred, *pred_n, *gt, *gt_n; /* [n][3] each */
+} samples;
+
+static void samples_free(samples *s)
 {
     free(s->pred), free(s->pred_n), free(s->gt), free(s->gt_n);
     memset(s, 0, sizeof *s);
 }
 
-int tcb_surface_samples_init(tcb_surface_samples *s, int n, tcb_error *herr)
+static int samples_init(samples *s, int n, tcb_error *herr)
 {
     size_t bytes = (size_t)n * 3 * sizeof(float);
-    *s = (tcb_surface_samples){n, malloc(bytes), malloc(bytes), malloc(bytes), malloc(bytes)};
+    *s = (samples){n, malloc(bytes), malloc(bytes), malloc(bytes), malloc(bytes)};
     if (s->pred && s->pred_n && s->gt && s->gt_n) return TCB_OK;
-    tcb_surface_samples_free(s);
+    samples_free(s);
     return tcb_fail(herr, TCB_ERR_NOMEM, "out of memory for %d surface samples", n);
 }
 
@@ -35,41 +41,35 @@ static void frame_stream(const tcb_cell_job *job, const char *what, int frame, t
 
 /* The method's surface of `frame`, sampled into s->pred / s->pred_n; its
  * failures (a bad mesh, one of no area) are the method's. */
-static int method_samples(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, int frame, tcb_rng *rng,
-                          tcb_surface_samples *s, tcb_error *merr)
+static int method_samples(const tcb_cell_job *job, void *self, int frame, samples *s, tcb_error *merr)
 {
+    tcb_rng rng;
+    frame_stream(job, "surface", frame, &rng);
     tcb_uv_mesh m = {0, 0, 0, NULL, NULL, NULL, NULL};
-    int rc = ops->surface(self, seq, frame, rng, &m, merr);
+    int rc = job->ops->surface(self, job->seq, frame, &rng, &m, merr);
     if (rc) {
         tcb_cell_ensure_error(merr, rc);
         tcb_error_prefix(merr, "surface of frame %d: ", frame);
     }
     if (!rc) rc = tcb_surface_check(&m, frame, INT_MAX, merr);
-    if (!rc && (rc = tcb_recon_sample(m.verts, m.faces, m.n_faces, s->n, rng, s->pred, s->pred_n, merr)))
+    if (!rc && (rc = tcb_recon_sample(m.verts, m.faces, m.n_faces, s->n, &rng, s->pred, s->pred_n, merr)))
         tcb_error_prefix(merr, "surface of frame %d: ", frame);
     tcb_uv_mesh_free(&m);
     return rc;
 }
 
-int tcb_surface_frame_metrics(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, int frame,
-                              tcb_rng *rng, tcb_rng *gt_rng, tcb_surface_samples *s, tcb_surface_record *rec,
-                              tcb_error *merr, tcb_error *herr)
+static int frame_metrics(const tcb_cell_job *job, void *self, int frame, samples *s, tcb_surface_record *rec,
+                         tcb_error *merr, tcb_error *herr)
 {
-    if (method_samples(ops, self, seq, frame, rng, s, merr)) return merr->code;
+    const tcb_sequence *seq = job->seq;
+    if (method_samples(job, self, frame, s, merr)) return merr->code;
+    tcb_rng rng;
+    frame_stream(job, "surface_gt", frame, &rng);
     rec->frame = frame;
-    int rc = tcb_recon_sample(tcb_seq_frame(seq, frame), seq->faces, seq->n_faces, s->n, gt_rng, s->gt, s->gt_n, herr);
+    int rc = tcb_recon_sample(tcb_seq_frame(seq, frame), seq->faces, seq->n_faces, s->n, &rng, s->gt, s->gt_n, herr);
     if (!rc) rc = tcb_recon_metrics(s->pred, s->pred_n, s->n, s->gt, s->gt_n, s->n, rec->v, herr);
     if (rc) tcb_error_prefix(herr, "surface metrics of frame %d: ", frame);
     return rc;
-}
-
-static int frame_metrics(const tcb_cell_job *job, void *self, int frame, tcb_surface_samples *s,
-                         tcb_surface_record *rec, tcb_error *merr, tcb_error *herr)
-{
-    tcb_rng rng, gt_rng;
-    frame_stream(job, "surface", frame, &rng);
-    frame_stream(job, "surface_gt", frame, &gt_rng);
-    return tcb_surface_frame_metrics(job->ops, self, job->seq, frame, &rng, &gt_rng, s, rec, merr, herr);
 }
 
 /* The frames of the split's pairs and of the clips into used[n_frames];
@@ -99,8 +99,8 @@ void tcb_cell_surface_metrics(const tcb_cell_job *job, void *self, tcb_cell_resu
 {
     if (job->surface_samples <= 0 || !tcb_method_has_surface(job->ops)) return;
     unsigned char *used = calloc((size_t)job->seq->n_frames, 1);
-    tcb_surface_samples s = {0};
-    if (!used || tcb_surface_samples_init(&s, job->surface_samples, herr)) {
+    samples s = {0};
+    if (!used || samples_init(&s, job->surface_samples, herr)) {
         free(used);
         if (!herr->code) tcb_fail(herr, TCB_ERR_NOMEM, "out of memory for %d frames", job->seq->n_frames);
         return;
@@ -116,5 +116,5 @@ void tcb_cell_surface_metrics(const tcb_cell_job *job, void *self, tcb_cell_resu
     }
     c->surface_samples = job->surface_samples;
     free(used);
-    tcb_surface_samples_free(&s);
+    samples_free(&s);
 }

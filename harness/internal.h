@@ -234,23 +234,6 @@ void tcb_cell_ensure_error(tcb_error *merr, int rc);
  * merr (harness/surface_check.c). */
 int tcb_surface_check(const tcb_uv_mesh *m, int frame, int max_charts, tcb_error *merr);
 
-/* Scratch for one frame's reconstruction metrics: the two sample sets
- * and their normals, [n][3] each. */
-typedef struct tcb_surface_samples {
-    int n;
-    float *pred, *pred_n, *gt, *gt_n;
-} tcb_surface_samples;
-int tcb_surface_samples_init(tcb_surface_samples *s, int n, tcb_error *herr);
-void tcb_surface_samples_free(tcb_surface_samples *s);
-
-/* One frame's reconstruction metrics into rec: the method's surface and
- * its samples drawn from rng, the GT mesh's from gt_rng (the method's
- * failures in merr, the harness's in herr). A cell's evaluation and
- * `tcbench calibrate` both run it. */
-int tcb_surface_frame_metrics(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, int frame,
-                              tcb_rng *rng, tcb_rng *gt_rng, tcb_surface_samples *s, tcb_surface_record *rec,
-                              tcb_error *merr, tcb_error *herr);
-
 /* The reconstruction metrics of the cell's evaluated frames (every frame of
  * the split's pairs and of the clips, once each, ascending) into
  * c->surface and c->summary.recon, when the method gives surfaces and

@@ -80,24 +80,56 @@ int tcb_time_unit(const tcb_method_ops *ops, void *self, const tcb_sequence *seq
     return time_calls(one_unit, &c, max_runs, budget_s, out, err);
 }
 
-int tcb_time_surface_frames(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, int n, int samples,
-                            double *frame_s, tcb_error *err)
+/* The method's surface of `frame`, made and freed; its seconds. */
+static int time_mesh(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, int frame, double *seconds,
+                     tcb_error *err)
 {
-    tcb_surface_samples s;
-    int rc = tcb_surface_samples_init(&s, samples, err);
-    double t0 = 0;
-    /* frame -1 (frame 0, untimed) sets up what a cell's first frame does */
-    for (int k = -1; !rc && k < n; k++) {
-        int frame = (k + 1) % seq->n_frames;
-        tcb_rng rng, gt_rng;
-        tcb_rng_seed_stream(&rng, 0, "calibrate/surface");
-        tcb_rng_seed_stream(&gt_rng, 0, "calibrate/surface_gt");
-        tcb_surface_record rec;
-        if (k == 0) t0 = tcb_now_seconds();
-        rc = tcb_surface_frame_metrics(ops, self, seq, frame, &rng, &gt_rng, &s, &rec, err, err);
+    tcb_rng rng;
+    tcb_rng_seed_stream(&rng, 0, "calibrate/surface");
+    tcb_uv_mesh m = {0, 0, 0, NULL, NULL, NULL, NULL};
+    double t0 = tcb_now_seconds();
+    int rc = ops->surface(self, seq, frame, &rng, &m, err);
+    *seconds = tcb_now_seconds() - t0;
+    tcb_uv_mesh_free(&m);
+    return rc;
+}
+
+/* The harness's part of the metrics of frame f: n samples of f's GT mesh,
+ * standing for a trained method's surface (an untrained one's heaps of
+ * points make the nearest-neighbour queries many times slower than a
+ * cell's), against n of the frame half the sequence away (a surface some
+ * way off the GT: the queries slow down with the distance); its seconds.
+ * buf: [4][n][3]. */
+static int time_metrics(const tcb_sequence *seq, int f, int n, float *buf, double *seconds, tcb_error *err)
+{
+    tcb_rng rng;
+    tcb_rng_seed_stream(&rng, 0, "calibrate/surface_gt");
+    size_t len = (size_t)n * 3;
+    const float *a = tcb_seq_frame(seq, f), *b = tcb_seq_frame(seq, (f + seq->n_frames / 2) % seq->n_frames);
+    double v[TCB_N_RECON], t0 = tcb_now_seconds();
+    int rc = tcb_recon_sample(a, seq->faces, seq->n_faces, n, &rng, buf, buf + len, err);
+    if (!rc) rc = tcb_recon_sample(b, seq->faces, seq->n_faces, n, &rng, buf + 2 * len, buf + 3 * len, err);
+    if (!rc) rc = tcb_recon_metrics(buf, buf + len, n, buf + 2 * len, buf + 3 * len, n, v, err);
+    *seconds = tcb_now_seconds() - t0;
+    return rc;
+}
+
+int tcb_time_surface_frames(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, int max_frames,
+                            double budget_s, int samples, tcb_step_timing *out, double *mesh_s, tcb_error *err)
+{
+    float *buf = malloc((size_t)samples * 12 * sizeof *buf);
+    int rc = buf ? TCB_OK : tcb_fail(err, TCB_ERR_NOMEM, "out of memory for %d surface samples", samples);
+    double t0 = tcb_now_seconds(), metrics = 0, mesh = 0, m = 0;
+    out->first_s = 0, out->steps = 0, *mesh_s = 0;
+    /* no warm-up: a cell's frames share nothing but the sample buffers */
+    while (!rc && out->steps < max_frames && (out->steps == 0 || tcb_now_seconds() - t0 < budget_s)) {
+        int f = out->steps % seq->n_frames;
+        rc = time_mesh(ops, self, seq, f, &mesh, err);
+        if (!rc) rc = time_metrics(seq, f, samples, buf, &m, err);
+        *mesh_s += mesh, metrics += m, out->steps++;
     }
-    *frame_s = (tcb_now_seconds() - t0) / n;
-    tcb_surface_samples_free(&s);
+    out->step_s = metrics / out->steps, *mesh_s /= out->steps;
+    free(buf);
     return rc;
 }
 

@@ -87,7 +87,8 @@ import json
 c = json.load(open("run/calibration.json"))
 kinds = {(e["kind"], e["method"], e["preset"], e["threads"]) for e in c["costs"]}
 assert {("step", "atlasnet", "tiny", 1), ("step", "cc", "tiny", 1), ("eval_pair", "cc", "tiny", 1),
-        ("surface_frame", "atlasnet", "tiny", 1), ("unit", "nricp", "", 1), ("score_pair", "", "", 1)} <= kinds, kinds
+        ("surface_frame", "atlasnet", "tiny", 1), ("surface_mesh", "atlasnet", "tiny", 1), ("unit", "nricp", "", 1),
+        ("score_pair", "", "", 1)} <= kinds, kinds
 units = {e["unit"] for e in c["costs"] if e["kind"] == "unit"}
 assert units == {"register_random", "register_neighbor", "assign"}, units
 assert all(e["size"] == 500 for e in c["costs"] if e["kind"] == "surface_frame"), c["costs"]

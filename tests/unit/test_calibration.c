@@ -55,6 +55,30 @@ static void one(tcb_calibration_set *s)
     add(&s->c[0], TCB_COST_STEP, "m", "p", 2, 5);
 }
 
+/* one() with m/p's pairs at 0.25 s and the scoring at 0.01 s, 1 thread. */
+static void priced(tcb_calibration_set *s)
+{
+    one(s);
+    add(&s->c[0], TCB_COST_EVAL_PAIR, "m", "p", 1, 0.25);
+    add(&s->c[0], TCB_COST_SCORE_PAIR, "", "", 1, 0.01);
+}
+
+static tcb_cost_estimate of_preset(const char *preset, long long steps)
+{
+    tcb_cost_estimate e = {.steps = steps};
+    snprintf(e.preset, sizeof e.preset, "%s", preset);
+    return e;
+}
+
+/* e priced unknown, its basis saying `why`. */
+static void assert_unknown(const tcb_calibration_set *s, const char *method, const tcb_cost_query *q,
+                           tcb_cost_estimate e, const char *why)
+{
+    tcb_cost_price_cell(s, method, q, 0, &e);
+    assert_true(e.fit_s < 0 && e.eval_s < 0);
+    if (!strstr(e.basis, why)) fail_msg("'%s' lacks '%s'", e.basis, why);
+}
+
 static double price(const tcb_calibration_set *s, int threads, int *extrapolated)
 {
     tcb_cost_price p;
@@ -118,12 +142,9 @@ static void test_price_cell(void **state)
 {
     (void)state;
     tcb_calibration_set s;
-    one(&s);
-    add(&s.c[0], TCB_COST_EVAL_PAIR, "m", "p", 1, 0.25);
-    add(&s.c[0], TCB_COST_SCORE_PAIR, "", "", 1, 0.01);
+    priced(&s);
     tcb_cost_query q = {10, 2000, 100, 1};
-    tcb_cost_estimate e = {.steps = 1000};
-    snprintf(e.preset, sizeof e.preset, "p");
+    tcb_cost_estimate e = of_preset("p", 1000);
     tcb_cost_price_cell(&s, "m", &q, 0, &e);
     assert_near(e.fit_s, 8000, 1e-9);
     /* 100 pairs x (0.25 + 0.01 x (2000/1000)^2) */
@@ -135,11 +156,7 @@ static void test_price_cell(void **state)
     assert_near(own.fit_s, 3, 0);
     assert_near(own.eval_s, 1 + 100 * 0.04, 1e-9);
     /* a preset not measured: unknown, with the command that measures it */
-    tcb_cost_estimate none = {.steps = 5};
-    snprintf(none.preset, sizeof none.preset, "big");
-    tcb_cost_price_cell(&s, "m", &q, 0, &none);
-    assert_true(none.fit_s < 0 && none.eval_s < 0);
-    assert_non_null(strstr(none.basis, "tcbench calibrate --only m --preset big"));
+    assert_unknown(&s, "m", &q, of_preset("big", 5), "tcbench calibrate --only m --preset big");
     tcb_calibration_set_free(&s);
 }
 
@@ -149,13 +166,11 @@ static void test_price_epochs_and_unit(void **state)
 {
     (void)state;
     tcb_calibration_set s;
-    one(&s);
-    add(&s.c[0], TCB_COST_EVAL_PAIR, "m", "p", 1, 0.25);
-    add(&s.c[0], TCB_COST_SCORE_PAIR, "", "", 1, 0.01);
+    priced(&s);
     add_sized(&s.c[0], TCB_COST_UNIT, "m", "p", "template", 0, 1, 3);
     tcb_cost_query q = {12, 1000, 4, 1};
-    tcb_cost_estimate e = {.steps = 10, .step_frames = 1, .n_units = 1};
-    snprintf(e.preset, sizeof e.preset, "p");
+    tcb_cost_estimate e = of_preset("p", 10);
+    e.step_frames = 1, e.n_units = 1;
     e.units[0] = (tcb_unit_use){"template", 1, 0, 0, 0};
     tcb_cost_price_cell(&s, "m", &q, 0, &e);
     assert_near(e.fit_s, 10 * 8 * 2 + 3, 1e-9);
@@ -163,11 +178,8 @@ static void test_price_epochs_and_unit(void **state)
     assert_non_null(strstr(e.basis, "10 steps x 16000.0 ms at its frames (1 thread, first) + 1 template x 3 s"));
     /* the frame count unknown: so is the fit */
     tcb_cost_query absent = {0, 0, 4, 1};
-    tcb_cost_estimate a = {.steps = 10, .step_frames = 1};
-    snprintf(a.preset, sizeof a.preset, "p");
-    tcb_cost_price_cell(&s, "m", &absent, 0, &a);
-    assert_true(a.fit_s < 0 && a.eval_s < 0);
-    assert_non_null(strstr(a.basis, "grows with the frame count"));
+    e.n_units = 0;
+    assert_unknown(&s, "m", &absent, e, "grows with the frame count");
     tcb_calibration_set_free(&s);
 }
 
@@ -196,41 +208,37 @@ static void test_price_units(void **state)
     /* a unit not measured: the command, without a preset */
     tcb_cost_estimate none = {.n_units = 1};
     none.units[0] = (tcb_unit_use){"register_neighbor", 1, 0, 1, 1};
+    assert_unknown(&s, "r", &q, none, "no unit register_neighbor of r measured: tcbench calibrate --only r");
     tcb_cost_price_cell(&s, "r", &q, 0, &none);
-    assert_true(none.fit_s < 0 && none.eval_s < 0);
-    assert_non_null(strstr(none.basis, "no unit register_neighbor of r measured: tcbench calibrate --only r"));
     assert_null(strstr(none.basis, "--preset"));
     /* a unit growing with the vertex count, the data absent */
     tcb_cost_query absent = {0, 0, 100, 2};
     tcb_cost_estimate a = {.n_units = 1};
     a.units[0] = e.units[0];
-    tcb_cost_price_cell(&s, "r", &absent, 0, &a);
-    assert_true(a.fit_s < 0 && a.eval_s < 0);
-    assert_non_null(strstr(a.basis, "grows with the vertex count"));
+    assert_unknown(&s, "r", &absent, a, "grows with the vertex count");
     tcb_calibration_set_free(&s);
 }
 
-/* The reconstruction metrics: per sample of a mesh from a frame measured
- * at 1000 samples, for the frames the pairs use: 2 frames and 1 pair draw
+/* The reconstruction metrics: the method's mesh of a frame, and the
+ * harness's part per sample of a mesh from a frame measured at 1000
+ * samples, for the frames the pairs use: 2 frames and 1 pair draw
  * 1.5 distinct frames on average ((0,0) (0,1) (1,0) (1,1): 1, 2, 2, 1). */
 static void test_price_surface(void **state)
 {
     (void)state;
     tcb_calibration_set s;
-    one(&s);
-    add(&s.c[0], TCB_COST_EVAL_PAIR, "m", "p", 1, 0.25);
-    add(&s.c[0], TCB_COST_SCORE_PAIR, "", "", 1, 0.01);
+    priced(&s);
     add_sized(&s.c[0], TCB_COST_SURFACE_FRAME, "m", "p", "", 1000, 1, 2.0);
+    add(&s.c[0], TCB_COST_SURFACE_MESH, "m", "p", 1, 0.5);
     tcb_cost_query q = {2, 1000, 1, 1};
-    tcb_cost_estimate e = {.steps = 1};
-    snprintf(e.preset, sizeof e.preset, "p");
+    tcb_cost_estimate e = of_preset("p", 1);
     tcb_cost_price_cell(&s, "m", &q, 500, &e);
-    assert_near(e.eval_s, 0.25 + 1.5 * 2.0 * 500 / 1000 + 0.01, 1e-9);
+    /* each frame: its mesh, 0.5 s, and the harness's part at half the samples */
+    assert_near(e.eval_s, 0.25 + 1.5 * (0.5 + 2.0 * 500 / 1000) + 0.01, 1e-9);
     /* not measured (another preset): the evaluation without them, and said */
     add(&s.c[0], TCB_COST_STEP, "m", "p2", 1, 1);
     add(&s.c[0], TCB_COST_EVAL_PAIR, "m", "p2", 1, 0.25);
-    tcb_cost_estimate o = {.steps = 1};
-    snprintf(o.preset, sizeof o.preset, "p2");
+    tcb_cost_estimate o = of_preset("p2", 1);
     tcb_cost_price_cell(&s, "m", &q, 500, &o);
     assert_near(o.eval_s, 0.25 + 0.01, 1e-9);
     assert_non_null(strstr(o.basis, "reconstruction metrics not measured: tcbench calibrate --only m --preset p2"));
