@@ -3,8 +3,9 @@ neupig_torch.py, written from the method's description), on a small
 random problem, against methods/neupig/model.c (tests/pytorch/neupig_step.c).
 
 The grids' preconditioned parameters u give the values v = M^-1 u, solved
-densely here (small grids); everything in float64. The DCT solve the
-bench's peer uses is checked against the dense one on the same grids.
+densely here (small grids); everything in float64. The DCT solve and the
+GEMM-form nearest neighbours the bench's peer uses are checked against the
+dense solve and the brute-force search on the same problem.
 Passes when the loss and each parameter block's gradient agree with the C
 float32 values to 1e-4 relative (to the block's largest entry).
 
@@ -100,7 +101,13 @@ for name, lo, hi in zip(names, bounds[:-1], bounds[1:]):
     print(f"gradient {name:12s}: max |C - ref| / max |ref| = {err:.2e} (max |ref| {scale:.3e})")
     assert scale > 0, f"{name}: the reference gradient is zero: the check would prove nothing"
     worst = max(worst, err)
-# the bench's solve (bench/train_step_neupig_torch.py) against the dense one
+# the bench's nearest neighbours and solve (bench/train_step_neupig_torch.py)
+# against the brute-force search and the dense solve
+with torch.no_grad():
+    gemm = nt.loss(arch, grids, mlp, prob, nt.solvers(arch, nt.dense_solver), EPOCH, EPOCHS, nt.nearest_sq_gemm)[0]
+err = abs(gemm.item() - total.item()) / abs(total.item())
+print(f"loss with the GEMM-form search: {err:.1e} from the brute-force one")
+assert err <= 1e-12, f"the GEMM-form nearest neighbours change the loss by {err:.1e}"
 for g, (dense, dct) in enumerate(zip(nt.solvers(arch, nt.dense_solver), nt.solvers(arch, nt.dct_solver))):
     u = grids[g].detach().reshape(-1, nt.widths(arch)[g])
     err = (torch.max(torch.abs(dct(u) - dense(u))) / torch.max(torch.abs(dense(u)))).item()

@@ -136,9 +136,12 @@ def nearest_sq_brute(a, b):
 
 
 def nearest_sq_gemm(a, b):
-    """The same minima by the distance matrix's GEMM form (large clouds)."""
-    d2 = (a * a).sum(-1)[:, None] + (b * b).sum(-1)[None] - 2 * a @ b.T
-    return d2.clamp_min(0).min(1).values
+    """The same minima for large clouds: the search by the distance
+    matrix's GEMM form without autograd, then each match's squared
+    distance with it (the gradient of a minimum is its match's)."""
+    with torch.no_grad():
+        idx = ((b * b).sum(-1)[None] - 2 * a @ b.T).argmin(1)
+    return ((a - b[idx]) ** 2).sum(-1)
 
 
 def loss(a, grids, mlp, prob, solve, epoch, epochs, nearest_sq=nearest_sq_brute):
