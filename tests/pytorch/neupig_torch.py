@@ -82,11 +82,15 @@ def dct_solver(r, lam):
     dt = torch.get_default_dtype()
     C, scale = C.to(dt), scale.to(dt)
 
+    def along_axes(B, x):  # B applied along z, y and x in turn: three GEMMs
+        x = torch.einsum("az,zyxw->ayxw", B, x)
+        x = torch.einsum("by,aywx->abwx", B, x.transpose(2, 3))
+        return torch.einsum("cx,abwx->abcw", B, x)
+
     def solve(u):
         w = u.shape[-1]
-        x = u.reshape(r, r, r, w)
-        x = torch.einsum("az,by,cx,zyxw->abcw", C, C, C, x) * scale[..., None]
-        return torch.einsum("az,by,cx,abcw->zyxw", C, C, C, x).reshape(r ** 3, w)
+        x = along_axes(C, u.reshape(r, r, r, w)) * scale[..., None]
+        return along_axes(C.T, x).reshape(r ** 3, w)
 
     return solve
 
