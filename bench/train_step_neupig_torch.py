@@ -25,20 +25,11 @@ usage: train_step_neupig_torch.py TEMPLATE_OBJ FRAMES POINTS LEVELS FEATURES HID
        (the paper's: 8 levels of 30 features, width 512, 5 000 points)
 """
 import math
-import os
-import resource
 import sys
-import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "tests", "pytorch"))
-try:
-    import torch
+import torch_peer
 
-    import neupig_torch as nt
-except ImportError as exc:
-    print(f"unavailable: {exc}", file=sys.stderr)
-    sys.exit(77)
+torch, nt = torch_peer.import_reference("neupig_torch")
 
 
 def read_obj(path):
@@ -90,19 +81,15 @@ def main():
     groups += [{"params": [grids[-1]], "lr": 0.005}, {"params": mlp, "lr": 1e-3}]
     opt = torch.optim.Adam(groups)
     solve = nt.solvers(a, nt.dct_solver)
-    epochs = iters + 1
+    epoch = [0]  # the confidence's exponent follows the epoch, as in a fit of iters + 1 epochs
 
-    def step(epoch):
+    def step():
         opt.zero_grad()
-        nt.loss(a, grids, mlp, prob, solve, epoch, epochs, nt.nearest_sq_gemm)[0].backward()
+        nt.loss(a, grids, mlp, prob, solve, epoch[0], iters + 1, nt.nearest_sq_gemm)[0].backward()
         opt.step()
+        epoch[0] += 1
 
-    step(0)
-    t0 = time.perf_counter()
-    for e in range(1, epochs):
-        step(e)
-    ms = (time.perf_counter() - t0) * 1e3 / iters
-    print(f"{ms:.3f} {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss}")
+    torch_peer.time_steps(step, 1, iters)
 
 
 if __name__ == "__main__":
