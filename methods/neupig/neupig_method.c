@@ -21,7 +21,10 @@
  * located on the template deformed to frame i (closest surface point,
  * barycentric coordinates: tcb/locate.h) and carried to the same point of
  * the template deformed to frame j; the harness projects it onto j's GT
- * vertices. reconstruct samples the deformed template's surface.
+ * vertices. reconstruct samples the deformed template's surface; surface
+ * returns that mesh itself, without charts (tcb/method.h: a template moved
+ * into every frame needs none, its vertices mark the same points in every
+ * frame), for the reconstruction metrics and `tcbench frames`.
  *
  * Checkpoints: the whole optimisation state in <work_dir>/train.ckpt
  * (continued bit-identically); the model file holds the parameters and the
@@ -391,6 +394,30 @@ static int reconstruct(void *self, const tcb_sequence *seq, int i, int j, int fr
     return TCB_OK;
 }
 
+/* The template deformed to `frame`, in the sequence's coordinates, without
+ * charts; the same faces in every frame. */
+static int surface(void *self, const tcb_sequence *seq, int frame, tcb_rng *rng, tcb_uv_mesh *out, tcb_error *err)
+{
+    (void)rng; /* deterministic: the fitted template's vertices */
+    neupig_method *m = self;
+    const tcb_uv_mesh none = {0, 0, 0, NULL, NULL, NULL, NULL};
+    *out = none;
+    int rc = check_frames(m, seq, frame, frame, err);
+    if (rc) return rc;
+    const tcb_mesh *t = &m->template_mesh;
+    size_t vbytes = (size_t)t->n_verts * 3 * sizeof *out->verts, fbytes = (size_t)t->n_faces * 3 * sizeof *out->faces;
+    out->verts = malloc(vbytes), out->faces = malloc(fbytes);
+    if (!out->verts || !out->faces) {
+        tcb_uv_mesh_free(out);
+        return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    }
+    memcpy(out->verts, frame_of(m, frame), vbytes);
+    unmap(m, out->verts, t->n_verts);
+    memcpy(out->faces, t->faces, fbytes);
+    out->n_verts = t->n_verts, out->n_faces = t->n_faces;
+    return TCB_OK;
+}
+
 /* ---- the model file: the parameters under a manifest of the architecture ---- */
 
 static cJSON *manifest(const neupig_method *m, size_t n_params)
@@ -463,4 +490,5 @@ const tcb_method_ops tcb_method_neupig = {
     .save = save,
     .load = load,
     .destroy = destroy,
+    .surface = surface,
 };
