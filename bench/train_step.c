@@ -35,16 +35,31 @@
  * cc_bench.h's products; the losses' nearest-neighbour searches are timed
  * but not counted.
  *
- * Targets (issues 3, 14): C ≥ 4× faster than PyTorch for the mca step at
- * paper scale, ≥ 3× for atlasnet and cc, the step at ≥ 60 % of peak.
- * Timings only; nothing is asserted.
+ * neupig (one epoch of tcb_neupig_train_step: every frame's deformation,
+ * the robust Chamfer against every frame's cloud, the edge term, backward,
+ * Adam) at the paper preset (8 levels of 30 features, width 512, 5 000
+ * points a frame, a template of up to 20 000 triangles) and the cpu
+ * preset's sizes, on the calibration sequence's 6 frames; its template is
+ * the method's own (Poisson surface of the keyframe, the `surface` of the
+ * trained model), written to a temporary OBJ for the peer
+ * train_step_neupig_torch.py (tests/pytorch/neupig_torch.py's reference
+ * loss, float32, torch.optim.Adam with the per-level rates). GFLOP/it
+ * counts the MLP: T*nv*(Din*H + H^2 + 7H) multiply-adds forward, 2x that
+ * backward; the grids, the Chamfer's nearest neighbours, the edge term and
+ * Adam are timed but not counted.
+ *
+ * Targets (issues 3, 14, 28): C ≥ 4× faster than PyTorch for the mca step at
+ * paper scale, ≥ 3× for atlasnet, cc and neupig, the step at ≥ 60 % of
+ * peak. Timings only; nothing is asserted.
  *
  * usage: bench_train_step [--iters N] [--threads T] [--preset paper|cpu|all]
  *                         [--method NAME] [--peak GFLOPS] [--no-torch]
  *                         [--torch SCRIPT] [--cc-torch SCRIPT]
+ *                         [--neupig-torch SCRIPT]
  * Defaults: 5 iterations, the OpenMP thread count, all presets and methods
- * (atlasnet, dsr, mca, cc), the peers train_step_torch.py and
- * train_step_cc_torch.py next to this file run by /usr/bin/python3. */
+ * (atlasnet, dsr, mca, cc, neupig), the peers train_step_torch.py,
+ * train_step_cc_torch.py and train_step_neupig_torch.py next to this file
+ * run by /usr/bin/python3. */
 #include <math.h>
 #include <omp.h>
 #include <stdarg.h>
@@ -57,6 +72,7 @@
 #include "atlas_bench.h"
 #include "cc_bench.h"
 #include "harness/calibration.h"
+#include "tcb/mesh.h"
 #include "tcb/registry.h"
 
 enum { P = 10, N = TCB_DEFAULT_INPUT_POINTS, PEER_SKIPPED = 77 };
@@ -77,6 +93,15 @@ typedef struct {
 
 static const cc_preset cc_presets[] = {{"cpu", {128, 64, 32, 6, 0}, 8, 500}, {"paper", {1024, 512, 64, 6, 0}, 16, 2500}};
 
+/* neupig_method.c's presets, in the order of presets[]: the MLP's input
+ * (features + 2 normal features + 8 time features) and width, the grid
+ * levels and features, the points per frame, for the peer and the FLOPs. */
+typedef struct {
+    int din, hidden, levels, features, points;
+} neupig_preset;
+
+static const neupig_preset neupig_presets[] = {{16 + 2 + 8, 128, 6, 16, 2500}, {30 + 2 + 8, 512, 8, 30, 5000}};
+
 static const struct {
     const char *name;
     int nt; /* tangents per value */
@@ -87,15 +112,18 @@ typedef struct {
     double peak;
     const char *preset; /* NULL: all */
     const char *method; /* NULL: all */
-    char script[4096], cc_script[4096];
+    char script[4096], cc_script[4096], neupig_script[4096];
 } options;
 
 #define die(...) bench_die("bench_train_step", __VA_ARGS__)
 
 /* Mean ms per training step of method `name` at `preset`, after one
  * warm-up step: the measurement `tcbench calibrate` makes
- * (tcb_time_train_steps through the method's train_steps). */
-static double time_c(const char *name, const char *preset, const tcb_sequence *seq, const options *o)
+ * (tcb_time_train_steps through the method's train_steps). With obj_path,
+ * the trained model's surface of frame 0 is written there as an OBJ and
+ * its vertex count to *nv. */
+static double time_c_surface(const char *name, const char *preset, const tcb_sequence *seq, const options *o,
+                             const char *obj_path, int *nv)
 {
     const tcb_method_ops *ops = tcb_registry_find(name);
     char params[64];
@@ -103,11 +131,27 @@ static double time_c(const char *name, const char *preset, const tcb_sequence *s
     tcb_error err = {0};
     void *self;
     if (!ops || ops->create(params, &self, &err)) die("%s: %s", name, ops ? err.msg : "not registered");
+    if (ops->abi_version < 5 || !ops->train_steps) die("%s: no train_steps in its table", name);
     tcb_fit_ctx ctx = {.seed = 1, .n_threads = o->threads};
     tcb_step_timing t;
     if (tcb_time_train_steps(ops, self, seq, &ctx, o->iters, INFINITY, &t, &err)) die("%s", err.msg);
+    if (obj_path) {
+        tcb_uv_mesh m = {0, 0, 0, NULL, NULL, NULL, NULL};
+        tcb_rng rng;
+        tcb_rng_seed_stream(&rng, 1, "bench/surface");
+        if (ops->abi_version < 3 || !ops->surface) die("%s: no surface in its table", name);
+        if (ops->surface(self, seq, 0, &rng, &m, &err) || tcb_obj_write(obj_path, m.verts, m.n_verts, m.faces, m.n_faces, &err))
+            die("%s: %s", name, err.msg);
+        *nv = m.n_verts;
+        tcb_uv_mesh_free(&m);
+    }
     ops->destroy(self);
     return t.step_s * 1e3;
+}
+
+static double time_c(const char *name, const char *preset, const tcb_sequence *seq, const options *o)
+{
+    return time_c_surface(name, preset, seq, o, NULL, NULL);
 }
 
 /* Runs a PyTorch peer command: 0 with *ms and *rss_kib, PEER_SKIPPED when
@@ -143,6 +187,16 @@ static int time_cc_torch(const options *o, const cc_preset *pr, double *ms, long
     return run_peer(cmd, ms, rss_kib);
 }
 
+static int time_neupig_torch(const options *o, const neupig_preset *pr, const char *obj, int frames, double *ms,
+                             long *rss_kib)
+{
+    char cmd[8192];
+    if ((size_t)snprintf(cmd, sizeof cmd, "/usr/bin/python3 '%s' '%s' %d %d %d %d %d %d %d", o->neupig_script, obj,
+                         frames, pr->points, pr->levels, pr->features, pr->hidden, o->iters, o->threads) >= sizeof cmd)
+        return -1;
+    return run_peer(cmd, ms, rss_kib);
+}
+
 static double peak_rss_mib(void)
 {
     struct rusage ru;
@@ -161,6 +215,8 @@ static void print_header(const options *o)
            "cc (tcb_cc_train_step, six network calls; bench/cc_bench.h): 6 encoders\n"
            "  B*N*(3*64 + 64*128 + 128*C) + B*C*Z, 6 decoders B*(2Z*Z + Z*Z/2 + Z/2*K)\n"
            "  + B*N*sum_l(din^2 + din*dout); backward ~2x.\n"
+           "neupig (one epoch: every frame; tcb_neupig_train_step): the MLP T*nv*(Din*H + H^2 + 7H),\n"
+           "  backward 2x; grids, Chamfer and edge terms not counted.\n"
            "Losses, nearest neighbours and Adam not counted. Peak %.0f GFLOP/s.\n", P, N, o->peak);
     printf("%-6s %-9s %8s %9s %8s %6s %10s %8s %9s %9s\n", "preset", "method", "GFLOP/it", "C ms/it", "GFLOP/s",
            "%peak", "torch ms", "torch/C", "C RSS MiB", "torch MiB");
@@ -203,11 +259,28 @@ static void run_cc_row(options *o, const cc_preset *pr, const tcb_sequence *seq)
     print_row(o, pr->name, "cc", 2 * (fwd + bwd) * 1e-9, ms, rc, tms, rss, o->cc_script);
 }
 
+/* neupig at preset pr: its template, the method's, in a temporary OBJ for
+ * the peer. */
+static void run_neupig_row(options *o, const preset *p, const neupig_preset *pr, const tcb_sequence *seq)
+{
+    char dir[] = "/tmp/bench_train_step_XXXXXX", obj[64];
+    if (!mkdtemp(dir)) die("cannot create a temporary directory in /tmp");
+    snprintf(obj, sizeof obj, "%s/template.obj", dir);
+    int nv = 0;
+    double tms = 0, ms = time_c_surface("neupig", p->name, seq, o, obj, &nv);
+    long rss = 0;
+    int rc = o->torch ? time_neupig_torch(o, pr, obj, seq->n_frames, &tms, &rss) : PEER_SKIPPED;
+    remove(obj), remove(dir);
+    double fwd = (double)seq->n_frames * nv * ((double)pr->din * pr->hidden + (double)pr->hidden * pr->hidden + 7.0 * pr->hidden);
+    print_row(o, p->name, "neupig", 2 * 3 * fwd * 1e-9, ms, rc, tms, rss, o->neupig_script);
+}
+
 static void parse(int argc, char **argv, options *o)
 {
     *o = (options){.iters = 5, .threads = omp_get_max_threads(), .torch = 1, .peak = 230};
     bench_sibling_path(o->script, sizeof o->script, __FILE__, "train_step_torch.py");
     bench_sibling_path(o->cc_script, sizeof o->cc_script, __FILE__, "train_step_cc_torch.py");
+    bench_sibling_path(o->neupig_script, sizeof o->neupig_script, __FILE__, "train_step_neupig_torch.py");
     for (int a = 1; a < argc; a++) {
         const char *v = a + 1 < argc ? argv[a + 1] : NULL;
         if (strcmp(argv[a], "--no-torch") == 0) o->torch = 0;
@@ -221,6 +294,8 @@ static void parse(int argc, char **argv, options *o)
             snprintf(o->script, sizeof o->script, "%s", v), a++;
         else if (strcmp(argv[a], "--cc-torch") == 0)
             snprintf(o->cc_script, sizeof o->cc_script, "%s", v), a++;
+        else if (strcmp(argv[a], "--neupig-torch") == 0)
+            snprintf(o->neupig_script, sizeof o->neupig_script, "%s", v), a++;
         else die("bad argument %s (usage: top of bench/train_step.c)", argv[a]);
     }
     if (o->iters < 1 || o->threads < 1 || o->peak <= 0)
@@ -228,8 +303,8 @@ static void parse(int argc, char **argv, options *o)
     if (o->preset && strcmp(o->preset, "cpu") && strcmp(o->preset, "paper"))
         die("--preset must be paper, cpu or all");
     if (o->method && strcmp(o->method, "atlasnet") && strcmp(o->method, "dsr") && strcmp(o->method, "mca") &&
-        strcmp(o->method, "cc"))
-        die("--method must be atlasnet, dsr, mca or cc");
+        strcmp(o->method, "cc") && strcmp(o->method, "neupig"))
+        die("--method must be atlasnet, dsr, mca, cc or neupig");
 }
 
 int main(int argc, char **argv)
@@ -247,6 +322,7 @@ int main(int argc, char **argv)
         for (size_t k = 0; want && k < sizeof methods / sizeof *methods; k++)
             if (!o.method || strcmp(o.method, methods[k].name) == 0) run_row(&o, &presets[i], (int)k, &seq);
         if (want && (!o.method || strcmp(o.method, "cc") == 0)) run_cc_row(&o, &cc_presets[i], &seq);
+        if (want && (!o.method || strcmp(o.method, "neupig") == 0)) run_neupig_row(&o, &presets[i], &neupig_presets[i], &seq);
     }
     tcb_sequence_free(&seq);
     return 0;

@@ -24,20 +24,11 @@ usage: train_step_cc_torch.py C Z H L B N ITERS THREADS [--selfrec]
        (the CC code's sizes: C 1024, Z 512, H 64, L 6, B 16, N 2500)
 """
 import math
-import os
-import resource
 import sys
-import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "tests", "pytorch"))
-try:
-    import torch
+import torch_peer
 
-    import cc_torch
-except ImportError as exc:
-    print(f"unavailable: {exc}", file=sys.stderr)
-    sys.exit(77)
+torch, cc_torch = torch_peer.import_reference("cc_torch")
 
 
 def main():
@@ -67,12 +58,7 @@ def main():
         total.backward()
         opt.step()
 
-    step()
-    t0 = time.perf_counter()
-    for _ in range(iters):
-        step()
-    ms = (time.perf_counter() - t0) * 1e3 / iters
-    print(f"{ms:.3f} {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss}")
+    torch_peer.time_steps(step, 1, iters)
 
 
 if __name__ == "__main__":

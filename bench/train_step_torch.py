@@ -14,20 +14,11 @@ Exit 77 (and a message on stderr) when torch cannot be imported.
 
 usage: train_step_torch.py METHOD C P M N ITERS THREADS [WARMUP]
 """
-import os
-import resource
 import sys
-import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "tests", "pytorch"))
-try:
-    import torch
+import torch_peer
 
-    import atlas_torch
-except ImportError as exc:
-    print(f"unavailable: {exc}", file=sys.stderr)
-    sys.exit(77)
+torch, atlas_torch = torch_peer.import_reference("atlas_torch")
 
 BATCH = 4
 
@@ -49,13 +40,7 @@ def main():
                                 exact_nn=False).backward()
         opt.step()
 
-    for _ in range(warmup):
-        step()
-    t0 = time.perf_counter()
-    for _ in range(iters):
-        step()
-    ms = (time.perf_counter() - t0) * 1e3 / iters
-    print(f"{ms:.3f} {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss}")
+    torch_peer.time_steps(step, warmup, iters)
 
 
 if __name__ == "__main__":

@@ -70,7 +70,9 @@ static void print_account(FILE *out, const tcb_cell_target *t, const int *frames
     fputc('\n', out);
     if (texture)
         fprintf(out, "  look for: a check pattern that slides over the body, flips or stretches from frame to "
-                     "frame (one texture, the same (u, v) in every frame)\n");
+                     "frame (one texture, the same (u, v) in every frame; a surface without charts: each vertex "
+                     "in the colour of its place in frame %d)\n",
+                frames[0]);
     else
         fprintf(out, "  look for: colours out of place in frames %s %d (each vertex in the colour of where "
                      "the transfer from frame %d sent it)\n",

@@ -28,7 +28,8 @@ int tcb_frames_transfer(const tcb_frames_job *f, tcb_error *err);
 #define TCB_FRAMES_COLLAPSED 0.05
 
 /* Marks collapsed[c] for each collapsed chart c of m (the surface of a
- * frame of GT area gt_area), their count in *n. (harness/frames_collapse.c) */
+ * frame of GT area gt_area), their count in *n (0 for a mesh without
+ * charts). (harness/frames_collapse.c) */
 int tcb_frames_collapsed(const tcb_uv_mesh *m, double gt_area, unsigned char *collapsed, int *n, tcb_error *err);
 
 /* The cell seed's stream "frames/<dataset>/<sequence>/<i>" (j < 0: the

@@ -1,14 +1,18 @@
 /* `tcbench frames` for a method with `surface`: its reconstruction of each
- * frame with one checkerboard in UV space (tcb/frames.h). */
+ * frame with one checkerboard in UV space, or, for a mesh without charts,
+ * each vertex in the colour of its place in the first frame drawn
+ * (tcb/frames.h). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "harness/checker.h"
+#include "harness/colormap.h"
 #include "harness/frames_style.h"
 #include "harness/render.h"
 #include "tcb/fsutil.h"
 #include "tcb/geometry.h"
+#include "tcb/mesh.h"
 
 /* More charts would make the texture larger than viewers like (16 x 16
  * cells of 256 pixels: 4096 pixels a side). */
@@ -24,8 +28,8 @@ static int same_topology(const tcb_uv_mesh *a, const tcb_uv_mesh *b, int fa, int
 {
     if (a->n_verts == b->n_verts && a->n_faces == b->n_faces && a->n_charts == b->n_charts &&
         !memcmp(a->faces, b->faces, 3 * (size_t)a->n_faces * sizeof *a->faces) &&
-        !memcmp(a->chart, b->chart, (size_t)a->n_verts * sizeof *a->chart) &&
-        !memcmp(a->uv, b->uv, 2 * (size_t)a->n_verts * sizeof *a->uv))
+        (a->n_charts == 0 || (!memcmp(a->chart, b->chart, (size_t)a->n_verts * sizeof *a->chart) &&
+                               !memcmp(a->uv, b->uv, 2 * (size_t)a->n_verts * sizeof *a->uv))))
         return TCB_OK;
     return tcb_fail(merr, TCB_ERR_INTERNAL,
                     "surface of frame %d differs from frame %d's in faces, charts or (u, v) (only vertices may move)",
@@ -119,7 +123,11 @@ static int collapsed_patches(const tcb_frames_job *f, const tcb_uv_mesh *mesh, i
     return TCB_OK;
 }
 
-static int write_strip(const tcb_frames_job *f, const tcb_uv_mesh *mesh, const tcb_checker *c, tcb_error *err)
+/* The strip: with charts each face in its texture colour (face_rgb
+ * [n_faces][3]), without each vertex in its colour (vertex_rgb
+ * [n_verts][3]); the same colours in every frame. */
+static int write_strip(const tcb_frames_job *f, const tcb_uv_mesh *mesh, const uint8_t *face_rgb,
+                       const uint8_t *vertex_rgb, tcb_error *err)
 {
     const tcb_uv_mesh *m0 = &mesh[0];
     tcb_render_panel panels[TCB_FRAMES_MAX];
@@ -127,36 +135,55 @@ static int write_strip(const tcb_frames_job *f, const tcb_uv_mesh *mesh, const t
     int n_collapsed[TCB_FRAMES_MAX];
     int rc = collapsed_patches(f, mesh, n_collapsed, err);
     if (rc) return rc;
-    uint8_t *rgb = malloc(3 * (size_t)m0->n_faces);
-    if (!rgb) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory for %d faces", m0->n_faces);
-    face_colors(m0, c, rgb);
     for (int k = 0; k < f->n; k++) {
         if (n_collapsed[k])
             snprintf(titles[k], sizeof titles[k], "frame %d: %d of %d patches collapsed", f->frames[k],
                      n_collapsed[k], mesh[k].n_charts);
         else
             snprintf(titles[k], sizeof titles[k], "frame %d", f->frames[k]);
-        panels[k] = (tcb_render_panel){titles[k], mesh[k].verts, NULL, rgb};
+        panels[k] = (tcb_render_panel){titles[k], mesh[k].verts, vertex_rgb, face_rgb};
     }
     const tcb_sequence *seq = f->cell->seq;
     rc = tcb_path_join(path, sizeof path, err, "%s/strip.png", f->dir);
     /* The view axis from the GT's first frame, as every strip and inspect's pair.png. */
-    if (!rc) rc = tcb_render_panels(path, panels, f->n, m0->n_verts, m0->faces, m0->n_faces,
-                                    tcb_seq_frame(seq, 0), seq->n_verts, 0, err);
-    free(rgb);
-    return rc;
+    return rc ? rc : tcb_render_panels(path, panels, f->n, m0->n_verts, m0->faces, m0->n_faces,
+                                       tcb_seq_frame(seq, 0), seq->n_verts, 0, err);
 }
 
-static int write_files(const tcb_frames_job *f, const tcb_uv_mesh *mesh, tcb_error *err)
+/* checker.png, checker.mtl, the textured OBJs and the strip. */
+static int write_charted(const tcb_frames_job *f, const tcb_uv_mesh *mesh, tcb_error *err)
 {
     tcb_checker c = tcb_checker_layout(mesh[0].n_charts);
     char path[TCB_PATH_MAX];
-    int rc = tcb_mkdirs(f->dir, err);
+    uint8_t *rgb = malloc(3 * (size_t)mesh[0].n_faces);
+    int rc = rgb ? tcb_mkdirs(f->dir, err) : tcb_fail(err, TCB_ERR_NOMEM, "out of memory for %d faces", mesh[0].n_faces);
     if (!rc) rc = tcb_path_join(path, sizeof path, err, "%s/checker.png", f->dir);
     if (!rc) rc = tcb_checker_write_png(&c, path, err);
     if (!rc) rc = write_mtl(f->dir, err);
     for (int k = 0; !rc && k < f->n; k++) rc = write_obj(f, k, &mesh[k], &c, err);
-    return rc ? rc : write_strip(f, mesh, &c, err);
+    if (!rc) face_colors(&mesh[0], &c, rgb);
+    if (!rc) rc = write_strip(f, mesh, rgb, NULL, err);
+    free(rgb);
+    return rc;
+}
+
+/* A mesh without charts: each vertex coloured by its position in the first
+ * frame drawn (the vertex is the same template point in every frame), as
+ * frame_<f>.ply and the strip. */
+static int write_chartless(const tcb_frames_job *f, const tcb_uv_mesh *mesh, tcb_error *err)
+{
+    const tcb_uv_mesh *m0 = &mesh[0];
+    char path[TCB_PATH_MAX];
+    uint8_t *rgb = malloc(3 * (size_t)m0->n_verts);
+    int rc = rgb ? tcb_mkdirs(f->dir, err) : tcb_fail(err, TCB_ERR_NOMEM, "out of memory for %d vertices", m0->n_verts);
+    if (!rc) tcb_color_by_position(m0->verts, m0->n_verts, rgb);
+    for (int k = 0; !rc && k < f->n; k++) {
+        rc = tcb_path_join(path, sizeof path, err, "%s/frame_%d.ply", f->dir, f->frames[k]);
+        if (!rc) rc = tcb_ply_write(path, mesh[k].verts, m0->n_verts, m0->faces, m0->n_faces, rgb, err);
+    }
+    if (!rc) rc = write_strip(f, mesh, NULL, rgb, err);
+    free(rgb);
+    return rc;
 }
 
 int tcb_frames_texture(const tcb_frames_job *f, tcb_error *err)
@@ -164,7 +191,7 @@ int tcb_frames_texture(const tcb_frames_job *f, tcb_error *err)
     surfaces s = {f, calloc((size_t)f->n, sizeof *s.mesh)};
     if (!s.mesh) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
     int rc = tcb_cell_use_method(f->cell, decode_frames, &s, err);
-    if (!rc) rc = write_files(f, s.mesh, err);
+    if (!rc) rc = s.mesh[0].n_charts ? write_charted(f, s.mesh, err) : write_chartless(f, s.mesh, err);
     for (int k = 0; k < f->n; k++) tcb_uv_mesh_free(&s.mesh[k]);
     free(s.mesh);
     return rc;

@@ -18,6 +18,13 @@
  *                   the frame's GT area) is titled so, and a warning
  *                   through the reporter lists them
  *
+ * A surface without charts (tcb/method.h; neupig's template moved into
+ * each frame) has no texture: each vertex keeps the colour of its place in
+ * the first chosen frame (as inspect's body-place colours) in every frame:
+ *
+ *   frame_<f>.ply   the surface of frame f in those colours
+ *   strip.png       the frames side by side, one camera
+ *
  * Every other method (style "transfer") is drawn as its correspondences:
  * the first chosen frame i on its GT mesh with vertices coloured by their
  * place on the body, and each other chosen frame j on its GT mesh with

@@ -121,19 +121,28 @@ typedef struct tcb_cost_estimate {
     tcb_unit_use units[TCB_MAX_UNIT_USES];
 } tcb_cost_estimate;
 
-/* A method's surface of one frame as a triangle mesh parametrised by
- * charts (`surface` below; `tcbench frames` textures it). Each vertex lies
- * in one chart at (u, v) in [0,1]^2; the harness places chart c's unit
- * square in cell c of one texture shared by every chart and frame, so the
- * method never knows the texture and the same (chart, u, v) is the same
- * texel in every frame: a chart that slides over the body shows it. */
+/* A method's surface of one frame as a triangle mesh (`surface` below),
+ * parametrised by charts or not.
+ *
+ * With charts (n_charts >= 1; the atlas family): each vertex lies in one
+ * chart at (u, v) in [0,1]^2; the harness places chart c's unit square in
+ * cell c of one texture shared by every chart and frame, so the method
+ * never knows the texture and the same (chart, u, v) is the same texel in
+ * every frame: a chart that slides over the body shows it.
+ *
+ * Without (n_charts 0, uv and chart NULL; a template moved into every
+ * frame, as neupig's): a vertex is its own mark, as it is the same point
+ * of the template in every frame; `tcbench frames` colours each vertex by
+ * its position in the first frame it draws, so a template that slides over
+ * the body shows it too. The reconstruction metrics use only verts and
+ * faces, with charts or without. */
 typedef struct tcb_uv_mesh {
     int n_verts, n_faces, n_charts;
     float *verts;    /* [n_verts][3] normalized coordinates, like transfer's */
-    float *uv;       /* [n_verts][2] in [0,1]^2 of the vertex's chart */
-    int32_t *chart;  /* [n_verts] in [0, n_charts) */
-    int32_t *faces;  /* [n_faces][3] vertex ids, counter-clockwise in (u, v);
-                      * a face's three vertices share a chart */
+    float *uv;       /* [n_verts][2] in [0,1]^2 of the vertex's chart; NULL without charts */
+    int32_t *chart;  /* [n_verts] in [0, n_charts); NULL without charts */
+    int32_t *faces;  /* [n_faces][3] vertex ids; with charts counter-clockwise
+                      * in (u, v), a face's three vertices in one chart */
 } tcb_uv_mesh;
 
 /* Frees what a method's `surface` malloc'ed and zeroes *m. */

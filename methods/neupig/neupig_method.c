@@ -21,7 +21,10 @@
  * located on the template deformed to frame i (closest surface point,
  * barycentric coordinates: tcb/locate.h) and carried to the same point of
  * the template deformed to frame j; the harness projects it onto j's GT
- * vertices. reconstruct samples the deformed template's surface.
+ * vertices. reconstruct samples the deformed template's surface; surface
+ * returns that mesh itself, without charts (tcb/method.h: a template moved
+ * into every frame needs none, its vertices mark the same points in every
+ * frame), for the reconstruction metrics and `tcbench frames`.
  *
  * Checkpoints: the whole optimisation state in <work_dir>/train.ckpt
  * (continued bit-identically); the model file holds the parameters and the
@@ -409,6 +412,31 @@ static int reconstruct(void *self, const tcb_sequence *seq, int i, int j, int fr
     return TCB_OK;
 }
 
+/* The template deformed to `frame`, in the sequence's coordinates, without
+ * charts; the same faces in every frame. */
+static int surface(void *self, const tcb_sequence *seq, int frame, tcb_rng *rng, tcb_uv_mesh *out, tcb_error *err)
+{
+    (void)rng; /* deterministic: the fitted template's vertices */
+    neupig_method *m = self;
+    const tcb_uv_mesh none = {0, 0, 0, NULL, NULL, NULL, NULL};
+    *out = none;
+    int rc = steps_model(m, err);
+    if (!rc) rc = check_frames(m, seq, frame, frame, err);
+    if (rc) return rc;
+    const tcb_mesh *t = &m->template_mesh;
+    size_t vbytes = (size_t)t->n_verts * 3 * sizeof *out->verts, fbytes = (size_t)t->n_faces * 3 * sizeof *out->faces;
+    out->verts = malloc(vbytes), out->faces = malloc(fbytes);
+    if (!out->verts || !out->faces) {
+        tcb_uv_mesh_free(out);
+        return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    }
+    memcpy(out->verts, frame_of(m, frame), vbytes);
+    unmap(m, out->verts, t->n_verts);
+    memcpy(out->faces, t->faces, fbytes);
+    out->n_verts = t->n_verts, out->n_faces = t->n_faces;
+    return TCB_OK;
+}
+
 /* ---- the model file: the parameters under a manifest of the architecture ---- */
 
 static cJSON *manifest(const neupig_method *m, size_t n_params)
@@ -474,7 +502,7 @@ static int load(void *self, const tcb_sequence *seq, const char *path, tcb_error
 
 /* tcb_method_ops.train_steps: fit's training (its inputs and template
  * built by the first call) n epochs at a time; the fitted model follows
- * from the epochs done when a transfer or reconstruct first asks
+ * from the epochs done when a transfer, reconstruct or surface first asks
  * (steps_model), so that the timed calls are epochs only. */
 struct steps {
     inputs in;
@@ -580,6 +608,7 @@ const tcb_method_ops tcb_method_neupig = {
     .load = load,
     .destroy = destroy,
     .estimate = estimate,
+    .surface = surface,
     .presets = calibrated_presets,
     .train_steps = train_steps,
     .units = unit_names,

@@ -61,6 +61,7 @@ int nricp_prepare(nricp_method *m, const tcb_sequence *seq, tcb_error *err)
                         seq->n_frames, seq->n_verts);
     m->n_frames = seq->n_frames, m->n_verts = seq->n_verts;
     nricp_chains_free(&m->chains); /* announced for the model this replaces */
+    nricp_ahead_free(&m->ahead);
     m->seq_hash = nricp_sequence_hash(seq);
     size_t frame = (size_t)seq->n_verts * 3;
     free(m->normals);
@@ -109,18 +110,20 @@ static int check_pair(const nricp_method *m, const tcb_sequence *seq, int i, int
     return TCB_OK;
 }
 
-/* propagate_deform runs the announced pairs' chains at once (deform.c);
- * the other strategies have nothing to prepare. */
+/* random registers the announced pairs ahead in parallel batches
+ * (random_ahead.c), propagate_deform runs their chains at once (deform.c);
+ * the propagating strategies have nothing to prepare. */
 static int nricp_prepare_pairs(void *self, const tcb_sequence *seq, const int *pairs, int first, int n,
                                const tcb_fit_ctx *ctx, tcb_error *err)
 {
     (void)first;
     nricp_method *m = self;
-    if (m->strategy != NRICP_DEFORM) return TCB_OK;
+    if (nricp_uses_maps(m->strategy)) return TCB_OK;
     for (int p = 0; p < n; p++) {
         int rc = check_pair(m, seq, pairs[2 * p], pairs[2 * p + 1], err);
         if (rc) return rc;
     }
+    if (m->strategy == NRICP_RANDOM) return nricp_ahead_announce(m, pairs, n, ctx->n_threads, err);
     return nricp_deform_pairs(m, seq, pairs, n, ctx, err);
 }
 
@@ -128,7 +131,7 @@ static int nricp_transfer(void *self, const tcb_sequence *seq, int i, int j, con
                           float *out, tcb_rng *rng, tcb_error *err)
 {
     (void)rng; /* deterministic: the inputs are the GT vertices themselves */
-    const nricp_method *m = self;
+    nricp_method *m = self;
     int rc = check_pair(m, seq, i, j, err);
     if (rc) return rc;
     /* Normals and vertex maps exist only for whole frames of GT vertices. */
@@ -137,9 +140,13 @@ static int nricp_transfer(void *self, const tcb_sequence *seq, int i, int j, con
                         "nricp: can only transfer the %d GT vertices of a frame, got %d points", m->n_verts,
                         n);
     switch (m->strategy) {
-    case NRICP_RANDOM:
+    case NRICP_RANDOM: {
+        int taken = 0;
+        rc = nricp_ahead_take(m, seq, i, j, src, out, &taken, err);
+        if (rc || taken) return rc;
         return nricp_register(src, nricp_normals_of(m, i), n, tcb_seq_frame(seq, j), nricp_normals_of(m, j), n,
                               &m->params, out, err);
+    }
     case NRICP_SIMPLE:
     case NRICP_BIJECTIVE:
         return compose_transfer(m, seq, i, j, out, err);
@@ -183,10 +190,11 @@ static int nricp_run_unit(void *self, const tcb_sequence *seq, const tcb_fit_ctx
     return rc;
 }
 
-/* The units a cell runs: the maps (registrations, and for bijective
- * assignments) spread over the cell's threads (maps.c), as do a deform
- * chain's steps (deform.c); random registers each pair, one after another.
- * Registrations scale with the rounds over the default's. */
+/* The units a cell runs, each on one thread, spread over the cell's
+ * threads: the maps (registrations, and for bijective assignments;
+ * maps.c), random's registration of each pair (random_ahead.c), a deform
+ * chain's steps (deform.c). Registrations scale with the rounds over the
+ * default's. */
 static void nricp_estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out)
 {
     const nricp_method *m = self;
@@ -202,7 +210,7 @@ static void nricp_estimate(void *self, const tcb_cost_query *q, tcb_cost_estimat
     out->fit_s = out->eval_s = 0;
     snprintf(out->basis, sizeof out->basis, "%s", name);
     if (m->strategy == NRICP_RANDOM)
-        u[out->n_units++] = (tcb_unit_use){"register_random", 0, q->n_pairs * rounds, REGISTER_EXPONENT, 1};
+        u[out->n_units++] = (tcb_unit_use){"register_random", 0, q->n_pairs * rounds / threads, REGISTER_EXPONENT, 1};
     if (nricp_uses_maps(m->strategy))
         u[out->n_units++] = (tcb_unit_use){"register_neighbor", maps * rounds, 0, REGISTER_EXPONENT, 1};
     if (m->strategy == NRICP_BIJECTIVE) u[out->n_units++] = (tcb_unit_use){"assign", maps, 0, ASSIGN_EXPONENT, 1};
@@ -219,6 +227,7 @@ static void nricp_destroy(void *self)
     free(m->normals);
     free(m->maps);
     nricp_chains_free(&m->chains);
+    nricp_ahead_free(&m->ahead);
     free(m);
 }
 

@@ -31,6 +31,16 @@ typedef struct nricp_chains {
     nricp_chain *c;
 } nricp_chains;
 
+/* random: the pairs prepare_pairs announced and a batch of their
+ * registrations, computed ahead (random_ahead.c). */
+typedef struct nricp_ahead {
+    int n, next;        /* announced pairs; the index of the next expected */
+    int *pairs;         /* [n][2] frames i, j */
+    int threads, cap;   /* the cell's threads; pairs per batch */
+    int first, count;   /* the batch in outs: pairs first .. first + count − 1 */
+    float *outs;        /* [cap][n_verts][3] */
+} nricp_ahead;
+
 typedef struct nricp_method {
     nricp_strategy strategy;
     nricp_params params;
@@ -44,6 +54,7 @@ typedef struct nricp_method {
     /* propagate_deform: the chains of the pairs prepare_pairs announced
      * (n = 0 before, and for the other strategies). */
     nricp_chains chains;
+    nricp_ahead ahead; /* random only (else empty) */
 } nricp_method;
 
 static inline int nricp_uses_maps(nricp_strategy s)
@@ -100,6 +111,16 @@ void nricp_chains_free(nricp_chains *cs);
 /* Registrations the chains of n uniformly drawn pairs (j ≠ i) over F
  * frames take, in expectation. */
 double nricp_deform_expected_steps(int n_frames, int n_pairs);
+
+/* random_ahead.c: announce resets the batches to the n pairs (i, j) of
+ * pairs[2p], pairs[2p + 1], to be registered over `threads`. take sets
+ * *taken and fills out when (i, j) from the frame's own vertices src is
+ * the next announced pair, registering the batch that starts there if it
+ * is not computed yet; else *taken is 0 and the caller registers it. */
+int nricp_ahead_announce(nricp_method *m, const int *pairs, int n, int threads, tcb_error *err);
+int nricp_ahead_take(nricp_method *m, const tcb_sequence *seq, int i, int j, const float *src, float *out,
+                     int *taken, tcb_error *err);
+void nricp_ahead_free(nricp_ahead *a);
 
 /* deform_store.c: one finished chain per file. read fills c->outs of a
  * chain whose source, step and targets are set. */

@@ -740,10 +740,11 @@ static int prepare_in(void *self, const tcb_sequence *s, const char *dir, int th
     return tcb_registry_find("nricp")->prepare_pairs(self, s, &deform_pairs[0][0], 0, N_DEFORM_PAIRS, &ctx, err);
 }
 
-/* Every pair's transfer equals the chain of its own, run pair by pair. */
-static void expect_pair_by_pair(void *prepared, const tcb_sequence *s)
+/* Every pair's transfer equals the one of an nricp of `strategy` that was
+ * told of no pairs (a chain of its own, a registration of its own). */
+static void expect_pair_by_pair(void *prepared, const tcb_sequence *s, const char *strategy)
 {
-    void *lone = fitted(s, all_strategies[3], 1, NULL);
+    void *lone = fitted(s, strategy, 1, NULL);
     float a[BLOB_VERTS * 3], b[BLOB_VERTS * 3];
     for (int p = 0; p < N_DEFORM_PAIRS; p++) {
         transfer(prepared, s, deform_pairs[p][0], deform_pairs[p][1], a);
@@ -766,8 +767,34 @@ static void test_deform_chains_share_prefixes(void **state)
     if (prepare_in(self, &s, NULL, 2, NULL, &log, &err)) fail_msg("prepare_pairs: %s", err.msg);
     assert_int_equal(log.calls, DEFORM_STEPS);
     assert_true(log.total == DEFORM_STEPS && log.done == DEFORM_STEPS);
-    expect_pair_by_pair(self, &s);
+    expect_pair_by_pair(self, &s, all_strategies[3]);
     tcb_registry_find("nricp")->destroy(self);
+    tcb_sequence_free(&s);
+}
+
+/* random registers the announced pairs ahead, in batches of 4 per thread
+ * (9 pairs on 2 threads: two batches), with the bits of one registration
+ * at a time; a pair out of the announced order is registered on its own
+ * and leaves the batches in place. */
+static void test_random_registers_ahead(void **state)
+{
+    (void)state;
+    tcb_sequence s;
+    make_blob_sequence(&s, SEQ_FRAMES);
+    void *self = fitted(&s, all_strategies[0], 2, NULL), *lone = fitted(&s, all_strategies[0], 1, NULL);
+    progress_log log = {0};
+    tcb_error err;
+    if (prepare_in(self, &s, NULL, 2, NULL, &log, &err)) fail_msg("prepare_pairs: %s", err.msg);
+    float a[BLOB_VERTS * 3], b[BLOB_VERTS * 3];
+    transfer(self, &s, 1, 3, a); /* not the next announced pair */
+    transfer(lone, &s, 1, 3, b);
+    assert_memory_equal(a, b, sizeof a);
+    assert_int_equal(((nricp_method *)self)->ahead.count, 0);
+    expect_pair_by_pair(self, &s, all_strategies[0]);
+    nricp_ahead *ahead = &((nricp_method *)self)->ahead;
+    assert_true(ahead->next == N_DEFORM_PAIRS && ahead->first == 8 && ahead->count == 1);
+    tcb_registry_find("nricp")->destroy(self);
+    tcb_registry_find("nricp")->destroy(lone);
     tcb_sequence_free(&s);
 }
 
@@ -803,7 +830,7 @@ static void test_deform_chains_resume(void **state)
     assert_true(tcb_is_file(first));
     if (prepare_in(self, &s, dir, 1, NULL, &resumed, &err)) fail_msg("resume: %s", err.msg);
     assert_true(resumed.total == DEFORM_STEPS - 4);
-    expect_pair_by_pair(self, &s);
+    expect_pair_by_pair(self, &s, all_strategies[3]);
 
     /* A flipped bit of a deformed point: only the checksum sees it. */
     corrupt_byte(first, -12);
@@ -812,7 +839,7 @@ static void test_deform_chains_resume(void **state)
     assert_true(redone.total == 4);
     if (redone.warnings != 1 || !strstr(redone.last_warning, first) || !strstr(redone.last_warning, "checksum"))
         fail_msg("warning: '%s'", redone.last_warning);
-    expect_pair_by_pair(self, &s);
+    expect_pair_by_pair(self, &s, all_strategies[3]);
 
     /* The chain 0 → 2 of another evaluation: frames 3 and 4 missing. */
     static const int other[] = {0, 2};
@@ -823,7 +850,7 @@ static void test_deform_chains_resume(void **state)
     if (prepare_in(self, &s, dir, 1, NULL, &again, &err)) fail_msg("again: %s", err.msg);
     assert_true(again.total == 4);
     if (!strstr(again.last_warning, "no deformed cloud at frame 3")) fail_msg("warning: '%s'", again.last_warning);
-    expect_pair_by_pair(self, &s);
+    expect_pair_by_pair(self, &s, all_strategies[3]);
     ops->destroy(self);
     tcb_sequence_free(&s);
 }
@@ -1040,6 +1067,7 @@ int main(void)
                                         tu_teardown_tmpdir),
         cmocka_unit_test_setup_teardown(test_stopped_fit_resumes, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test(test_deform_chains_share_prefixes),
+        cmocka_unit_test(test_random_registers_ahead),
         cmocka_unit_test_setup_teardown(test_deform_chains_resume, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test_setup_teardown(test_deform_chain_file_checks, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test(test_deform_expected_steps),
