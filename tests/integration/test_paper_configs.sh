@@ -28,6 +28,10 @@ done
 "$TCBENCH" datasets synth --out synth --sequence quadruped_walk --frames 8 2> /dev/null
 mkdir ama && ln -s "$tmp/synth/quadruped_walk" ama/crane
 t5="$TCB_SOURCE_DIR/configs/paper/table5-nricp.json"
+# nricp's units measured here, into the run directory's calibration, which
+# the dry run reads first (the built-in's coverage: test_calibrate.sh)
+expect 0 "wrote $tmp/run/calibration.json" "$TCBENCH" calibrate --only nricp --quick --threads 1 --budget 2 \
+    --out "$tmp/run/calibration.json"
 expect 0 "ama/crane: 8 frames, " "$TCBENCH" run "$t5" --root ama="$tmp/ama" --dry-run --out "$tmp/run"
 grep -qE "^ +3  propagate_deform +0  missing +0(\.0)? s +[0-9.]+ (s|min)  propagate_deform: " out.txt ||
     { echo "FAIL: no estimate for cell 3"; cat out.txt; exit 1; }
