@@ -36,6 +36,11 @@
 
 /* Parallelize a query set only when it is worth a thread team. */
 #define PAR_MIN_WORK 65536.0
+/* The same for the kd-tree, by query count: FLANN opens a team for every
+ * call, so a caller asking one query at a time (tcb_mesh_locate's growing
+ * k) paid a team's start and wake-up per query — with two threads and
+ * passive waiting, 3x one thread's time (neupig's transfer, calibrate). */
+#define PAR_MIN_KD_QUERIES 64
 
 _Static_assert(sizeof(int) == sizeof(int32_t), "FLANN's C API returns int indices");
 
@@ -66,7 +71,7 @@ static inline float dist2(const float *p, const float *q)
     return dx * dx + dy * dy + dz * dz;
 }
 
-static struct FLANNParameters kdtree_params(int k)
+static struct FLANNParameters kdtree_params(int k, int nq)
 {
     struct FLANNParameters p = DEFAULT_FLANN_PARAMETERS;
     p.algorithm = FLANN_INDEX_KDTREE_SINGLE;
@@ -74,7 +79,7 @@ static struct FLANNParameters kdtree_params(int k)
     p.eps = 0.0f;
     p.sorted = 1;
     p.max_neighbors = k;
-    p.cores = omp_get_max_threads();
+    p.cores = nq >= PAR_MIN_KD_QUERIES ? omp_get_max_threads() : 1;
     p.log_level = FLANN_LOG_NONE;
     p.random_seed = 0; /* > 0 would reseed the C library's global rand() */
     return p;
@@ -100,7 +105,7 @@ static int build_kdtree(tcb_nn *nn, const float *pts, tcb_error *err)
     nn->pts = malloc((size_t)nn->n * 3 * sizeof(float));
     if (!nn->pts) return tcb_fail(err, TCB_ERR_NOMEM, "nn: out of memory");
     memcpy(nn->pts, pts, (size_t)nn->n * 3 * sizeof(float));
-    struct FLANNParameters p = kdtree_params(1);
+    struct FLANNParameters p = kdtree_params(1, 1);
     float speedup = 0.0f;
     nn->index = flann_build_index_float(nn->pts, nn->n, 3, &speedup, &p);
     if (!nn->index) return tcb_fail(err, TCB_ERR_INTERNAL, "nn: FLANN failed to build a kd-tree");
@@ -137,7 +142,7 @@ void tcb_nn_free(tcb_nn *nn)
 {
     if (!nn) return;
     if (nn->index) {
-        struct FLANNParameters p = kdtree_params(1);
+        struct FLANNParameters p = kdtree_params(1, 1);
         flann_free_index_float(nn->index, &p);
     }
     free(nn->x), free(nn->y), free(nn->z), free(nn->pts);
@@ -270,7 +275,7 @@ static int kdtree_queryk(const tcb_nn *nn, const float *queries, int nq, int k, 
     /* The C API takes non-const pointers but does not write the queries. It
      * also sets FLANN's global log level from p on every call; tcbench always
      * passes the same one. */
-    struct FLANNParameters p = kdtree_params(k);
+    struct FLANNParameters p = kdtree_params(k, nq);
     int rc = flann_find_nearest_neighbors_index_float(nn->index, (float *)queries, nq, idx,
                                                        dist, k, &p);
     if (rc != 0) rc = tcb_fail(err, TCB_ERR_INTERNAL, "nn: FLANN search failed");
