@@ -9,8 +9,8 @@
  * Params (presets overridable key by key; default cpu):
  *   preset   paper (1 000 epochs, 5 000 points a frame, 20 000 triangles,
  *            depth 10, the reference's network), fast (the paper's
- *            250-epoch variant), cpu (provisional sizing for 2 cores, to
- *            be chosen on the cat: issue 28), tiny (tests)
+ *            250-epoch variant), cpu (the paper's 1 000 epochs at sizes
+ *            for 2 cores: docs/protocol.md, "Neu-PiG"), tiny (tests)
  *   normals  estimated (default: PCA, oriented; tcbench's methods see
  *            points only) | gt (the reference's setting: the ground-truth
  *            face normal at each keyframe point)
@@ -59,7 +59,7 @@ typedef struct neupig_preset {
 static const neupig_preset presets[] = {
     {1000, 5000, 20000, 10, 8, 30, 512}, /* paper */
     {250, 5000, 20000, 10, 8, 30, 512},  /* fast */
-    {250, 2500, 5000, 8, 6, 16, 128},    /* cpu (provisional) */
+    {1000, 2500, 5000, 8, 6, 16, 128},   /* cpu */
     {30, 300, 400, 6, 3, 8, 16},         /* tiny */
 };
 static const char *const preset_names[] = {"paper", "fast", "cpu", "tiny", NULL};
