@@ -42,6 +42,7 @@
 #include "methods/step_cost.h"
 #include "neural/train_loop.h"
 #include "neural/weights.h"
+#include "tcb/fsutil.h"
 #include "tcb/geodesic.h"
 #include "tcb/geometry.h"
 #include "tcb/json.h"
@@ -299,6 +300,29 @@ static int deform_all(neupig_method *m, const inputs *in, tcb_error *err)
 
 /* ---- fit ---- */
 
+/* Points of the cube back in the sequence's coordinates, in place. */
+static void unmap(const neupig_method *m, float *pts, int n)
+{
+    for (size_t i = 0; i < 3 * (size_t)n; i++) pts[i] = (float)(pts[i] / m->map.scale + m->map.centre[i % 3]);
+}
+
+/* The template as fitting starts, in the sequence's coordinates, for people
+ * to open and check against the keyframe's GT mesh (scripts/
+ * neupig_template.py): <work_dir>/template_keyframe_<K>.obj. */
+static int write_template(const neupig_method *m, const char *work_dir, int keyframe, tcb_error *err)
+{
+    const tcb_mesh *t = &m->template_mesh;
+    char path[TCB_PATH_MAX];
+    float *verts = malloc((size_t)t->n_verts * 3 * sizeof *verts);
+    if (!verts) return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    memcpy(verts, t->verts, (size_t)t->n_verts * 3 * sizeof *verts);
+    unmap(m, verts, t->n_verts);
+    int rc = tcb_path_join(path, sizeof path, err, "%s/template_keyframe_%d.obj", work_dir, keyframe);
+    if (!rc) rc = tcb_obj_write(path, verts, t->n_verts, t->faces, t->n_faces, err);
+    free(verts);
+    return rc;
+}
+
 static int fit_step(void *t, double *loss, tcb_error *err) { return tcb_neupig_train_step(t, loss, err); }
 static long long fit_done(const void *t) { return ((const tcb_neupig_trainer *)t)->it; }
 
@@ -328,6 +352,7 @@ static int fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_
     inputs in;
     fit_state s = {.seed = ctx->seed};
     int rc = prepare(m, seq, ctx->seed, &in, err);
+    if (!rc) rc = write_template(m, ctx->work_dir, in.key, err);
     if (!rc) rc = tcb_neupig_trainer_init(&s.trainer, &m->arch, &m->sched, &in.problem, ctx->seed, err);
     if (!rc) {
         tcb_train_loop loop = {.name = "neupig", .iterations = m->sched.epochs, .checkpoint_every = m->checkpoint_every,
@@ -360,12 +385,6 @@ static int check_frames(const neupig_method *m, const tcb_sequence *seq, int i, 
 static const float *frame_of(const neupig_method *m, int f)
 {
     return m->deformed + (size_t)f * (size_t)m->template_mesh.n_verts * 3;
-}
-
-/* Points of the cube back in the sequence's coordinates, in place. */
-static void unmap(const neupig_method *m, float *pts, int n)
-{
-    for (size_t i = 0; i < 3 * (size_t)n; i++) pts[i] = (float)(pts[i] / m->map.scale + m->map.centre[i % 3]);
 }
 
 static int steps_model(neupig_method *m, tcb_error *err);
