@@ -27,6 +27,40 @@
 
 #define TAKEOVER_STALE_S 60.0 /* a taker that died mid-takeover */
 
+static void progress_path(char *out, size_t size, const char *lock)
+{
+    snprintf(out, size, "%s.progress", lock);
+}
+
+/* Removes <lock>.progress and a killed writer's temporaries of it: the
+ * previous holder's progress is not the new holder's. */
+static void clear_progress(const char *lock)
+{
+    char path[TCB_PATH_MAX + 16], dir[TCB_PATH_MAX + 16], prefix[TCB_PATH_MAX + 32];
+    progress_path(path, sizeof path, lock);
+    unlink(path);
+    snprintf(dir, sizeof dir, "%s", path);
+    char *slash = strrchr(dir, '/');
+    snprintf(prefix, sizeof prefix, "%s.tmp-", slash ? slash + 1 : path);
+    if (slash) *slash = '\0';
+    tcb_remove_stale_temps(slash ? dir : ".", prefix);
+}
+
+/* Writes the lock's latest progress, if new, into <lock>.progress; called
+ * with l->mu held, which it drops while writing. */
+static void write_progress(tcb_cell_lock *l)
+{
+    if (!l->progress_new) return;
+    char text[sizeof l->progress + 1], path[TCB_PATH_MAX + 16];
+    int n = snprintf(text, sizeof text, "%s\n", l->progress);
+    l->progress_new = 0;
+    pthread_mutex_unlock(&l->mu);
+    progress_path(path, sizeof path, l->path);
+    tcb_error err = {0};
+    (void)tcb_write_file_atomic(path, text, (size_t)n, &err); /* a status nicety: never fails the cell */
+    pthread_mutex_lock(&l->mu);
+}
+
 static void *heartbeat(void *arg)
 {
     tcb_cell_lock *l = arg;
@@ -37,10 +71,57 @@ static void *heartbeat(void *arg)
         double period = l->timeout_s / 4 < 1 ? 1 : l->timeout_s / 4;
         until.tv_sec += (time_t)period;
         pthread_cond_timedwait(&l->cv, &l->mu, &until);
-        if (!l->stop) utimensat(AT_FDCWD, l->path, NULL, 0);
+        if (l->stop) break;
+        utimensat(AT_FDCWD, l->path, NULL, 0);
+        write_progress(l);
     }
     pthread_mutex_unlock(&l->mu);
     return NULL;
+}
+
+void tcb_cell_lock_progress(tcb_cell_lock *l, double done, double total, const char *label)
+{
+    if (!l->beating) return;
+    pthread_mutex_lock(&l->mu);
+    if (total > 0)
+        snprintf(l->progress, sizeof l->progress, "%s %.0f/%.0f (%.0f %%)", label ? label : "", done, total,
+                 100.0 * done / total);
+    else
+        snprintf(l->progress, sizeof l->progress, "%s", label ? label : "");
+    l->progress_new = 1;
+    pthread_mutex_unlock(&l->mu);
+}
+
+static void lock_reporter_progress(void *ctx, double done, double total, const char *label)
+{
+    tcb_lock_reporter *r = ctx;
+    tcb_cell_lock_progress(r->lock, done, total, label);
+    tcb_report_progress(&r->inner, done, total, label);
+}
+
+static void lock_reporter_log(void *ctx, tcb_log_level level, const char *msg)
+{
+    tcb_lock_reporter *r = ctx;
+    if (r->inner.log) r->inner.log(r->inner.ctx, level, msg);
+}
+
+tcb_reporter tcb_lock_reporter_make(tcb_lock_reporter *storage, tcb_cell_lock *lock, const tcb_reporter *inner)
+{
+    storage->lock = lock;
+    storage->inner = *inner;
+    return (tcb_reporter){lock_reporter_progress, lock_reporter_log, storage};
+}
+
+/* The holder's progress note beside the lock at `path`, into info. */
+static void read_progress(const char *path, tcb_lock_info *info)
+{
+    char ppath[TCB_PATH_MAX + 16], *text;
+    tcb_error err = {0};
+    progress_path(ppath, sizeof ppath, path);
+    if (tcb_read_file(ppath, &text, NULL, &err)) return;
+    snprintf(info->progress, sizeof info->progress, "%s", text);
+    info->progress[strcspn(info->progress, "\n")] = '\0';
+    free(text);
 }
 
 /* The lock file at `path`: 0, or -1 when there is none. */
@@ -68,6 +149,7 @@ static int read_lock(const char *path, tcb_lock_info *info)
     clock_gettime(CLOCK_REALTIME, &now);
     info->heartbeat_age_s = (double)(now.tv_sec - st.st_mtim.tv_sec) + (now.tv_nsec - st.st_mtim.tv_nsec) * 1e-9;
     info->valid = ok;
+    read_progress(path, info);
     return 0;
 }
 
@@ -164,6 +246,7 @@ int tcb_cell_lock_acquire(tcb_cell_lock *l, const char *cell_path, double timeou
     unlink(tmp);
     if (rc || !claimed) return rc;
     l->held = 1;
+    clear_progress(l->path);
     pthread_mutex_init(&l->mu, NULL);
     pthread_cond_init(&l->cv, NULL);
     if (pthread_create(&l->thread, NULL, heartbeat, l)) {
@@ -186,6 +269,7 @@ void tcb_cell_lock_release(tcb_cell_lock *l)
     }
     pthread_cond_destroy(&l->cv);
     pthread_mutex_destroy(&l->mu);
+    clear_progress(l->path);
     unlink(l->path);
     l->held = l->beating = 0;
 }

@@ -88,6 +88,8 @@ typedef struct tcb_lock_info {
     long pid;
     double started;             /* Unix time */
     double heartbeat_age_s;     /* now − mtime */
+    char progress[160];         /* the holder's last progress ("mca 21000/40000"),
+                                 * as of its last heartbeat; "" when none */
 } tcb_lock_info;
 
 typedef struct tcb_cell_lock {
@@ -97,6 +99,8 @@ typedef struct tcb_cell_lock {
     pthread_t thread;           /* refreshes the heartbeat every timeout/4 */
     pthread_mutex_t mu;
     pthread_cond_t cv;
+    char progress[160];         /* under mu: the cell's latest progress */
+    int progress_new;           /* under mu: not yet in <lock>.progress */
 } tcb_cell_lock;
 
 /* Claims the cell at cell_path: l->held = 1 on success. When another live
@@ -104,7 +108,18 @@ typedef struct tcb_cell_lock {
  * *holder; a stale lock is taken over and `note` says whose and why. */
 int tcb_cell_lock_acquire(tcb_cell_lock *l, const char *cell_path, double timeout_s, tcb_lock_info *holder,
                           char *note, size_t note_size, tcb_error *err);
-/* Stops the heartbeat and removes the lock; nothing when not held. */
+/* Notes the cell's progress; each heartbeat writes the latest into
+ * <lock>.progress, where `tcbench status` reads it. Thread-safe. */
+void tcb_cell_lock_progress(tcb_cell_lock *l, double done, double total, const char *label);
+/* A reporter that notes progress in `lock` and passes everything on to
+ * `inner`; `storage` holds both and must outlive the reporter. */
+typedef struct tcb_lock_reporter {
+    tcb_cell_lock *lock;
+    tcb_reporter inner;
+} tcb_lock_reporter;
+tcb_reporter tcb_lock_reporter_make(tcb_lock_reporter *storage, tcb_cell_lock *lock, const tcb_reporter *inner);
+/* Stops the heartbeat and removes the lock (and its progress); nothing
+ * when not held. */
 void tcb_cell_lock_release(tcb_cell_lock *l);
 /* The holder of the cell at cell_path: 0, or -1 when it has no lock. */
 int tcb_cell_lock_holder(const char *cell_path, tcb_lock_info *info);

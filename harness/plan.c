@@ -69,7 +69,8 @@ static void cell_state_message(const char *run_dir, const tcb_dataset_spec *d, c
     tcb_lock_info h;
     if (!tcb_is_file(path)) {
         if (!tcb_cell_lock_holder(path, &h))
-            snprintf(out, size, "running (%s pid %ld, heartbeat %.0f s ago)", h.host, h.pid, h.heartbeat_age_s);
+            snprintf(out, size, "running (%s pid %ld, heartbeat %.0f s ago%s%s)", h.host, h.pid, h.heartbeat_age_s,
+                     h.progress[0] ? "; " : "", h.progress);
         return;
     }
     tcb_cell_result c;

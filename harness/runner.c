@@ -240,9 +240,12 @@ static int note_failure(tcb_run_stats *stats, const char *label, const char *mes
     return TCB_OK;
 }
 
+/* The cell under `lock`; its progress goes to the run's reporter and to
+ * the lock, where `tcbench status` reads it. */
 static int run_cell(const run_state *st, const seq_ctx *sc, const tcb_method_spec *m, int seed,
-                    const char *cell_path, tcb_error *err)
+                    const char *cell_path, tcb_cell_lock *lock, tcb_error *err)
 {
+    tcb_lock_reporter via_lock;
     char work[TCB_PATH_MAX], ckpt[TCB_PATH_MAX];
     int rc = tcb_harness_work_paths(st->run_dir, sc->dataset->name, sc->seq->name, m->label, seed,
                                     work, ckpt, err);
@@ -264,7 +267,7 @@ static int run_cell(const run_state *st, const seq_ctx *sc, const tcb_method_spe
         .checkpoint = ckpt,
         .git_revision = st->git_revision,
         .load_s = sc->load_s,
-        .reporter = st->opts->reporter,
+        .reporter = tcb_lock_reporter_make(&via_lock, lock, &st->opts->reporter),
         .interrupted = st->opts->interrupted,
         .interrupt_arg = st->opts->interrupt_arg,
         .clips = sc->clips,
@@ -343,7 +346,7 @@ static int claim_and_run(const run_state *st, const seq_ctx *sc, const tcb_metho
     }
     if (note[0]) tcb_report_log(&st->opts->reporter, TCB_LOG_WARN, "%s: %s", label, note);
     rc = kept_result(st, m, sc, path, &keep, err);
-    if (!rc && !keep) rc = run_cell(st, sc, m, seed, path, err);
+    if (!rc && !keep) rc = run_cell(st, sc, m, seed, path, &lock, err);
     tcb_cell_lock_release(&lock);
     return rc;
 }

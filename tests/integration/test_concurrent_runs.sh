@@ -87,4 +87,17 @@ touch -d '-2 minutes' "$cell.lock"
 "$TCBENCH" run grid.json --out foreign --lock-timeout 60 2> stale.log
 grep -qF "took over the lock of node-17 pid 4242: its heartbeat stopped" stale.log || { cat stale.log; exit 1; }
 same_cells plain foreign
+
+# A live holder's progress: each heartbeat (every --lock-timeout/4 s) notes
+# it beside the lock, `cells` shows it, and it goes with the lock.
+sed 's/"delay_ms": 30/"delay_ms": 300/; s/"seeds": \[0, 1, 2\]/"seeds": [0]/' grid.json > progress.json
+cell=prog/cells/synth/quadruped_walk/slow/seed_0.json
+"$TCBENCH" run progress.json --out prog --only slow --lock-timeout 4 --quiet 2> prog.log & pids+=($!)
+for _ in $(seq 200); do [ -s "$cell.lock.progress" ] && break; sleep 0.1; done
+"$TCBENCH" cells progress.json --out prog > prog_cells.txt
+wait "${pids[@]}"
+pids=()
+grep -qE "slow +[0-9]+  running \(.* heartbeat [0-9]+ s ago; synth/quadruped_walk/slow/seed 0 [0-9]+/10 \([0-9]+ %\)\)" \
+    prog_cells.txt || { echo "FAIL: no progress in cells"; cat prog_cells.txt prog.log; exit 1; }
+[ -z "$(find prog -name '*.lock*')" ] || { echo "FAIL: lock or progress left"; find prog -name '*.lock*'; exit 1; }
 echo "concurrent runs test passed"
