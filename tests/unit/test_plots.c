@@ -12,11 +12,14 @@
 #include <cmocka.h>
 
 #include <cairo.h>
+#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "fake_run.h"
+#include "reports/chart.h"
+#include "tcb/config.h"
 #include "tcb/fsutil.h"
 #include "tcb/report.h"
 #include "testutil.h"
@@ -126,6 +129,46 @@ static void test_colour_follows_the_label(void **state)
     tu_remove_tree(two), tu_remove_tree(three);
 }
 
+/* The salt's promise, checked on the configs themselves: within each
+ * shipped config the method labels have distinct colours (distinct
+ * colour-and-dash pairs where there are more labels than colours). */
+static int check_config_styles(const char *dir)
+{
+    DIR *d = opendir(dir);
+    assert_non_null(d);
+    int n = 0;
+    for (struct dirent *e; (e = readdir(d));) {
+        char path[8192];
+        size_t len = strlen(e->d_name);
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        if (e->d_name[0] == '.') continue;
+        if (e->d_type == DT_DIR) {
+            n += check_config_styles(path);
+            continue;
+        }
+        if (len < 6 || strcmp(e->d_name + len - 5, ".json")) continue;
+        tcb_config c;
+        tcb_error err = {0};
+        if (tcb_config_load(path, &c, &err)) fail_msg("%s", err.msg);
+        int modulus = c.n_methods <= 10 ? 10 : 40;
+        for (int a = 0; a < c.n_methods; a++)
+            for (int b = a + 1; b < c.n_methods; b++)
+                if (tcb_chart_style_of(c.methods[a].label) % modulus == tcb_chart_style_of(c.methods[b].label) % modulus)
+                    fail_msg("%s: %s and %s share a %s", path, c.methods[a].label, c.methods[b].label,
+                             modulus == 10 ? "colour" : "colour and dash");
+        tcb_config_free(&c);
+        n++;
+    }
+    closedir(d);
+    return n;
+}
+
+static void test_shipped_labels_have_their_own_colours(void **state)
+{
+    (void)state;
+    assert_true(check_config_styles(TCB_SOURCE_DIR "/configs") >= 10);
+}
+
 /* Pair 1 moved from |i - j| = 2 to 4: distances 2 and 3 have no pairs. */
 static void move_pair_to_gap_4(cJSON *root, const void *arg)
 {
@@ -193,6 +236,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_colour_follows_the_label),
+        cmocka_unit_test(test_shipped_labels_have_their_own_colours),
         cmocka_unit_test(test_gap_plot_shows_the_best_and_skips_holes),
         cmocka_unit_test(test_yaw_plot_in_plus_minus_180),
     };
