@@ -3,6 +3,7 @@
 
 #include "tcb/rng.h"
 
+#include <dirent.h>
 #include <ftw.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -113,4 +114,28 @@ int tu_closed_oriented(const int32_t *faces, int nf)
     }
     free(e);
     return ok;
+}
+
+int tu_for_each_json(const char *dir, void (*fn)(const char *path, void *arg), void *arg)
+{
+    DIR *d = opendir(dir);
+    if (!d) {
+        fprintf(stderr, "%s: cannot open\n", dir);
+        abort();
+    }
+    int n = 0;
+    for (struct dirent *e; (e = readdir(d));) {
+        char path[8192];
+        size_t len = strlen(e->d_name);
+        if (e->d_name[0] == '.') continue;
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        if (e->d_type == DT_DIR) {
+            n += tu_for_each_json(path, fn, arg);
+        } else if (len >= 6 && !strcmp(e->d_name + len - 5, ".json")) {
+            fn(path, arg);
+            n++;
+        }
+    }
+    closedir(d);
+    return n;
 }

@@ -26,6 +26,9 @@ void tu_write_text(const char *dir, const char *name, const char *text, char *ou
 int tu_setup_tmpdir(void **state);
 int tu_teardown_tmpdir(void **state);
 
+/* Calls fn on every *.json under dir, subdirectories included (dot names
+ * skipped); returns how many. */
+int tu_for_each_json(const char *dir, void (*fn)(const char *path, void *arg), void *arg);
 /* rm -rf of a directory made by tu_make_tmpdir. */
 void tu_remove_tree(const char *dir);
 

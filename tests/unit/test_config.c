@@ -6,7 +6,6 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
-#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -382,30 +381,13 @@ static void test_missing_lists_and_name(void **state)
     }
 }
 
-/* Loads every *.json of dir, and of its subdirectories; returns how many. */
-static int load_all(const char *dir)
+static void load_one(const char *path, void *arg)
 {
-    DIR *d = opendir(dir);
-    assert_non_null(d);
-    int n = 0;
-    for (struct dirent *e; (e = readdir(d));) {
-        char path[8192];
-        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
-        size_t len = strlen(e->d_name);
-        if (e->d_name[0] == '.') continue;
-        if (e->d_type == DT_DIR) {
-            n += load_all(path);
-            continue;
-        }
-        if (len < 6 || strcmp(e->d_name + len - 5, ".json")) continue;
-        tcb_config c;
-        tcb_error err = {0};
-        if (tcb_config_load(path, &c, &err)) fail_msg("%s", err.msg);
-        tcb_config_free(&c);
-        n++;
-    }
-    closedir(d);
-    return n;
+    (void)arg;
+    tcb_config c;
+    tcb_error err = {0};
+    if (tcb_config_load(path, &c, &err)) fail_msg("%s", err.msg);
+    tcb_config_free(&c);
 }
 
 /* Every config shipped in configs/ (configs/paper/ too) parses: a typo
@@ -416,7 +398,7 @@ static void test_shipped_configs_parse(void **state)
     (void)state;
     char dir[4096];
     snprintf(dir, sizeof dir, "%s/configs", TCB_SOURCE_DIR);
-    assert_true(load_all(dir) >= 10);
+    assert_true(tu_for_each_json(dir, load_one, NULL) >= 10);
 }
 
 int main(void)

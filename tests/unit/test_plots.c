@@ -12,7 +12,6 @@
 #include <cmocka.h>
 
 #include <cairo.h>
-#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -132,41 +131,25 @@ static void test_colour_follows_the_label(void **state)
 /* The salt's promise, checked on the configs themselves: within each
  * shipped config the method labels have distinct colours (distinct
  * colour-and-dash pairs where there are more labels than colours). */
-static int check_config_styles(const char *dir)
+static void check_config_styles(const char *path, void *arg)
 {
-    DIR *d = opendir(dir);
-    assert_non_null(d);
-    int n = 0;
-    for (struct dirent *e; (e = readdir(d));) {
-        char path[8192];
-        size_t len = strlen(e->d_name);
-        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
-        if (e->d_name[0] == '.') continue;
-        if (e->d_type == DT_DIR) {
-            n += check_config_styles(path);
-            continue;
-        }
-        if (len < 6 || strcmp(e->d_name + len - 5, ".json")) continue;
-        tcb_config c;
-        tcb_error err = {0};
-        if (tcb_config_load(path, &c, &err)) fail_msg("%s", err.msg);
-        int modulus = c.n_methods <= 10 ? 10 : 40;
-        for (int a = 0; a < c.n_methods; a++)
-            for (int b = a + 1; b < c.n_methods; b++)
-                if (tcb_chart_style_of(c.methods[a].label) % modulus == tcb_chart_style_of(c.methods[b].label) % modulus)
-                    fail_msg("%s: %s and %s share a %s", path, c.methods[a].label, c.methods[b].label,
-                             modulus == 10 ? "colour" : "colour and dash");
-        tcb_config_free(&c);
-        n++;
-    }
-    closedir(d);
-    return n;
+    (void)arg;
+    tcb_config c;
+    tcb_error err = {0};
+    if (tcb_config_load(path, &c, &err)) fail_msg("%s", err.msg);
+    int modulus = c.n_methods <= 10 ? 10 : 40;
+    for (int a = 0; a < c.n_methods; a++)
+        for (int b = a + 1; b < c.n_methods; b++)
+            if (tcb_chart_style_of(c.methods[a].label) % modulus == tcb_chart_style_of(c.methods[b].label) % modulus)
+                fail_msg("%s: %s and %s share a %s", path, c.methods[a].label, c.methods[b].label,
+                         modulus == 10 ? "colour" : "colour and dash");
+    tcb_config_free(&c);
 }
 
 static void test_shipped_labels_have_their_own_colours(void **state)
 {
     (void)state;
-    assert_true(check_config_styles(TCB_SOURCE_DIR "/configs") >= 10);
+    assert_true(tu_for_each_json(TCB_SOURCE_DIR "/configs", check_config_styles, NULL) >= 10);
 }
 
 /* Pair 1 moved from |i - j| = 2 to 4: distances 2 and 3 have no pairs. */
