@@ -216,3 +216,14 @@ void tcb_remove_stale_temps(const char *dir, const char *prefix)
     }
     closedir(d);
 }
+
+void tcb_remove_stale_temps_of(const char *path)
+{
+    char dir[TCB_PATH_MAX], prefix[TCB_PATH_MAX];
+    snprintf(dir, sizeof dir, "%s", path);
+    char *slash = strrchr(dir, '/');
+    const char *base = slash ? slash + 1 : path;
+    if ((size_t)snprintf(prefix, sizeof prefix, "%s.tmp-", base) >= sizeof prefix) return;
+    if (slash) *slash = '\0';
+    tcb_remove_stale_temps(slash ? dir : ".", prefix);
+}

@@ -36,14 +36,10 @@ static void progress_path(char *out, size_t size, const char *lock)
  * previous holder's progress is not the new holder's. */
 static void clear_progress(const char *lock)
 {
-    char path[TCB_PATH_MAX + 16], dir[TCB_PATH_MAX + 16], prefix[TCB_PATH_MAX + 32];
+    char path[TCB_PATH_MAX + 16];
     progress_path(path, sizeof path, lock);
     unlink(path);
-    snprintf(dir, sizeof dir, "%s", path);
-    char *slash = strrchr(dir, '/');
-    snprintf(prefix, sizeof prefix, "%s.tmp-", slash ? slash + 1 : path);
-    if (slash) *slash = '\0';
-    tcb_remove_stale_temps(slash ? dir : ".", prefix);
+    tcb_remove_stale_temps_of(path);
 }
 
 /* Writes the lock's latest progress, if new, into <lock>.progress; called
@@ -79,7 +75,7 @@ static void *heartbeat(void *arg)
     return NULL;
 }
 
-void tcb_cell_lock_progress(tcb_cell_lock *l, double done, double total, const char *label)
+static void note_progress(tcb_cell_lock *l, double done, double total, const char *label)
 {
     if (!l->beating) return;
     pthread_mutex_lock(&l->mu);
@@ -95,7 +91,7 @@ void tcb_cell_lock_progress(tcb_cell_lock *l, double done, double total, const c
 static void lock_reporter_progress(void *ctx, double done, double total, const char *label)
 {
     tcb_lock_reporter *r = ctx;
-    tcb_cell_lock_progress(r->lock, done, total, label);
+    note_progress(r->lock, done, total, label);
     tcb_report_progress(&r->inner, done, total, label);
 }
 

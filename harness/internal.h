@@ -108,11 +108,10 @@ typedef struct tcb_cell_lock {
  * *holder; a stale lock is taken over and `note` says whose and why. */
 int tcb_cell_lock_acquire(tcb_cell_lock *l, const char *cell_path, double timeout_s, tcb_lock_info *holder,
                           char *note, size_t note_size, tcb_error *err);
-/* Notes the cell's progress; each heartbeat writes the latest into
- * <lock>.progress, where `tcbench status` reads it. Thread-safe. */
-void tcb_cell_lock_progress(tcb_cell_lock *l, double done, double total, const char *label);
-/* A reporter that notes progress in `lock` and passes everything on to
- * `inner`; `storage` holds both and must outlive the reporter. */
+/* A reporter that notes progress in `lock` (each heartbeat writes the
+ * latest into <lock>.progress, where `tcbench status` reads it; thread-safe)
+ * and passes everything on to `inner`; `storage` holds both and must
+ * outlive the reporter. */
 typedef struct tcb_lock_reporter {
     tcb_cell_lock *lock;
     tcb_reporter inner;

@@ -27,20 +27,6 @@ typedef struct run_state {
     const unsigned char *refused; /* [n_methods] 1: the run directory refused the method (run_config.c) */
 } run_state;
 
-/* Unlinks "<path>.tmp-*" left by a writer killed before its rename: a
- * resumed run must not leave debris that a finished run would not have. */
-static void remove_stale_temps(const char *path)
-{
-    char dir[TCB_PATH_MAX];
-    snprintf(dir, sizeof dir, "%s", path);
-    char *slash = strrchr(dir, '/');
-    const char *base = slash ? slash + 1 : path;
-    if (slash) *slash = '\0';
-    char prefix[TCB_PATH_MAX];
-    if ((size_t)snprintf(prefix, sizeof prefix, "%s.tmp-", base) >= sizeof prefix) return;
-    tcb_remove_stale_temps(slash ? dir : ".", prefix);
-}
-
 /* A cell's work directory holds only its method's checkpoints (the model
  * after fit, a training in progress, an external command's own files, in
  * subdirectories too). --force starts the cell from nothing, so it empties
@@ -252,7 +238,7 @@ static int run_cell(const run_state *st, const seq_ctx *sc, const tcb_method_spe
     if (!rc) rc = tcb_mkdirs(work, err);
     if (!rc) rc = prepare_work_dir(work, st->opts->force, err);
     if (rc) return rc;
-    remove_stale_temps(cell_path);
+    tcb_remove_stale_temps_of(cell_path); /* a resumed run leaves no debris a finished one would not */
     tcb_cell_job job = {
         .seq = sc->seq,
         .split = sc->split,

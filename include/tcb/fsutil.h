@@ -43,6 +43,8 @@ int tcb_publish(const char *tmp, const char *path, tcb_error *err);
  * temporaries of live writers (another tcbench process working on the same
  * run) are kept. */
 void tcb_remove_stale_temps(const char *dir, const char *prefix);
+/* The same for the temporaries of one file: <path>.tmp-*. */
+void tcb_remove_stale_temps_of(const char *path);
 
 int tcb_write_file_atomic(const char *path, const void *data, size_t len,
                           tcb_error *err);
