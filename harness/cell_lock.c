@@ -149,10 +149,9 @@ static int read_lock(const char *path, tcb_lock_info *info)
     return 0;
 }
 
-/* Why the holder no longer counts, or NULL while it does. An unreadable
- * lock counts until its heartbeat is old: it may be in the middle of being
- * written by a takeover. */
-static const char *stale_reason(const tcb_lock_info *h, double timeout_s)
+/* An unreadable lock counts until its heartbeat is old: it may be in the
+ * middle of being written by a takeover. */
+const char *tcb_cell_lock_stale_reason(const tcb_lock_info *h, double timeout_s)
 {
     char me[256] = "";
     gethostname(me, sizeof me - 1);
@@ -232,7 +231,7 @@ int tcb_cell_lock_acquire(tcb_cell_lock *l, const char *cell_path, double timeou
     if (!claimed && errno != EEXIST) {
         rc = tcb_fail(err, TCB_ERR_IO, "%s: cannot create the lock: %s", l->path, strerror(errno));
     } else if (!claimed && !read_lock(l->path, holder)) {
-        const char *why = stale_reason(holder, timeout_s);
+        const char *why = tcb_cell_lock_stale_reason(holder, timeout_s);
         if (why && (claimed = take_over(l->path, tmp, holder)))
             snprintf(note, note_size, "took over the lock of %s pid %ld: %s (heartbeat %.0f s old)", holder->host,
                      holder->pid, why, holder->heartbeat_age_s);

@@ -59,6 +59,8 @@ int tcb_run_dir_claim(const tcb_config *cfg, const char *run_dir, int force, tcb
 /* Pieces of the runner the dry run shares (harness/runner.c): */
 /* the method is the one --only names, or every method without --only; */
 int tcb_run_selected(const tcb_run_opts *opts, const tcb_method_spec *m);
+/* the age past which a cell lock's holder no longer counts (--lock-timeout); */
+double tcb_run_lock_timeout(const tcb_run_opts *opts);
 /* every selected method exists and accepts its params; */
 int tcb_run_check_methods(const tcb_config *cfg, const tcb_run_opts *opts, tcb_error *err);
 /* d's data cannot be read: no root, or no such directory; */
@@ -122,6 +124,10 @@ tcb_reporter tcb_lock_reporter_make(tcb_lock_reporter *storage, tcb_cell_lock *l
 void tcb_cell_lock_release(tcb_cell_lock *l);
 /* The holder of the cell at cell_path: 0, or -1 when it has no lock. */
 int tcb_cell_lock_holder(const char *cell_path, tcb_lock_info *info);
+/* Why the holder no longer counts (its heartbeat is older than timeout_s,
+ * or it was a process of this host that is gone): a run takes its lock
+ * over. NULL while it counts. */
+const char *tcb_cell_lock_stale_reason(const tcb_lock_info *h, double timeout_s);
 
 /* The cells of a run directory that Slurm has queued (pending or running
  * array tasks submitted by scripts/slurm/submit.sh), from squeue

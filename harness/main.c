@@ -253,7 +253,8 @@ static int cmd_status(const cli *c)
     if (rc) return rc;
     tcb_term_progress tp; /* warnings only (squeue's failure) */
     tcb_term_progress_init(&tp, stderr, 1);
-    tcb_run_opts opts = {.output = resolved.value[F_OUT], .reporter = tcb_term_progress_reporter(&tp)};
+    tcb_run_opts opts = {.output = resolved.value[F_OUT], .reporter = tcb_term_progress_reporter(&tp),
+                         .lock_timeout_s = (double)flag_int(&resolved, F_LOCK_TIMEOUT, 0)};
     rc = tcb_run_status(&cfg, &opts, stdout, &err);
     tcb_config_free(&cfg);
     return rc ? fail(&err) : 0;
@@ -265,7 +266,7 @@ static int cmd_cells(const cli *c)
     tcb_config cfg;
     int rc = load_config(c, &cfg);
     if (rc) return rc;
-    tcb_run_opts opts = {.output = c->value[F_OUT]};
+    tcb_run_opts opts = {.output = c->value[F_OUT], .lock_timeout_s = (double)flag_int(c, F_LOCK_TIMEOUT, 0)};
     rc = tcb_run_list_cells(&cfg, &opts, stdout, &err);
     tcb_config_free(&cfg);
     return rc ? fail(&err) : 0;
@@ -612,27 +613,32 @@ static const command commands[] = {
      "examples:\n"
      "  tcbench run configs/quick.json --out runs/quick --report\n"
      "  tcbench run configs/paper/table5-nricp.json --root ama=../shared/data/ama --dry-run\n"},
-    {"cells", cmd_cells, BIT(F_OUT) | BIT(F_ROOT) | BIT(F_VARIANT), 1, 1, "CONFIG",
+    {"cells", cmd_cells, BIT(F_OUT) | BIT(F_ROOT) | BIT(F_VARIANT) | BIT(F_LOCK_TIMEOUT), 1, 1, "CONFIG",
      "usage: tcbench cells CONFIG [--variant NAME] [--root DATASET=DIR]... [--out DIR]\n"
      "\n"
      "Lists the config's cells, numbered in one fixed order (datasets, sequences,\n"
      "methods, seeds) that depends only on the config, with each cell's state in the\n"
-     "run directory: done, failed, diverged or missing. 'tcbench run --cell' and\n"
-     "'--shard' take these ids.\n"
+     "run directory: done, failed, diverged, missing, running (with the holder's\n"
+     "progress) or stale (its holder was killed or stopped beating: the next run\n"
+     "takes it over). 'tcbench run --cell' and '--shard' take these ids.\n"
      "\n"
      "options:\n"
      "  --variant NAME  the config's variant (default: its first)\n"
      "  --root D=DIR    as for run (the states do not depend on it)\n"
      "  --out DIR       run directory (default: the config's \"output\")\n"
+     "  --lock-timeout S  a lock whose heartbeat is older than S s is stale (600)\n"
      "\n"
      "example:\n"
      "  tcbench cells configs/paper/table5-nricp.json\n"},
-    {"status", cmd_status, BIT(F_OUT) | BIT(F_ROOT) | BIT(F_VARIANT), 1, 1, "RUN_DIR or CONFIG",
-     "usage: tcbench status RUN_DIR|CONFIG [--variant NAME] [--out DIR]\n"
+    {"status", cmd_status, BIT(F_OUT) | BIT(F_ROOT) | BIT(F_VARIANT) | BIT(F_LOCK_TIMEOUT), 1, 1,
+     "RUN_DIR or CONFIG",
+     "usage: tcbench status RUN_DIR|CONFIG [--variant NAME] [--out DIR] [--lock-timeout S]\n"
      "\n"
-     "Where a run stands: the running cells (host, pid, heartbeat age), the failed\n"
+     "Where a run stands: the running cells (host, pid, heartbeat age, progress),\n"
+     "the stale ones (their holder was killed, or its heartbeat is older than\n"
+     "--lock-timeout, 600 s by default: the next run takes them over), the failed\n"
      "and diverged ones with their messages, the count per state, and the ids of\n"
-     "the missing cells as a Slurm --array list to resubmit. Cells whose array\n"
+     "the cells a run computes as a Slurm --array list to resubmit. Cells whose array\n"
      "tasks squeue lists as pending or running (jobs of scripts/slurm/submit.sh,\n"
      "whose comment names the run directory) count as queued, not missing. A run\n"
      "directory is read through the config it saved (RUN_DIR/config.json).\n"
@@ -640,6 +646,7 @@ static const command commands[] = {
      "options:\n"
      "  --variant NAME  with a CONFIG: its variant (default: the first)\n"
      "  --out DIR       with a CONFIG: the run directory (default: its \"output\")\n"
+     "  --lock-timeout S  as for run: a lock whose heartbeat is older is stale\n"
      "\n"
      "examples:\n"
      "  tcbench status runs/paper/table6-delta/cpu\n"

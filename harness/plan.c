@@ -56,10 +56,13 @@ static void probe(const tcb_dataset_spec *d, const char *name, int *n_frames, in
     if (rc) *n_frames = *n_verts = 0;
 }
 
-/* done, failed, diverged, unreadable, missing, or "running (host pid, age)"
- * while a lock of a live holder is on a cell without a result. */
-static void cell_state_message(const char *run_dir, const tcb_dataset_spec *d, const char *seq,
-                               const tcb_method_spec *m, int seed, char *out, size_t size, char *msg, size_t msg_size)
+/* done, failed, diverged, unreadable, missing, "running (host pid, age;
+ * progress)" while a lock whose holder counts is on a cell without a result,
+ * or "stale (host pid: why, ...)" when the next run will take that lock over
+ * (the holder was killed, or its machine went away). */
+static void cell_state_message(const char *run_dir, const tcb_run_opts *opts, const tcb_dataset_spec *d,
+                               const char *seq, const tcb_method_spec *m, int seed, char *out, size_t size,
+                               char *msg, size_t msg_size)
 {
     if (msg) msg[0] = '\0';
     char path[TCB_PATH_MAX];
@@ -68,9 +71,10 @@ static void cell_state_message(const char *run_dir, const tcb_dataset_spec *d, c
     if (tcb_cell_path(path, sizeof path, run_dir, d->name, seq, m->label, seed, &err)) return;
     tcb_lock_info h;
     if (!tcb_is_file(path)) {
-        if (!tcb_cell_lock_holder(path, &h))
-            snprintf(out, size, "running (%s pid %ld, heartbeat %.0f s ago%s%s)", h.host, h.pid, h.heartbeat_age_s,
-                     h.progress[0] ? "; " : "", h.progress);
+        if (tcb_cell_lock_holder(path, &h)) return;
+        const char *stale = tcb_cell_lock_stale_reason(&h, tcb_run_lock_timeout(opts));
+        snprintf(out, size, "%s (%s pid %ld%s%s, heartbeat %.0f s ago%s%s)", stale ? "stale" : "running", h.host, h.pid,
+                 stale ? ": " : "", stale ? stale : "", h.heartbeat_age_s, h.progress[0] ? "; " : "", h.progress);
         return;
     }
     tcb_cell_result c;
@@ -83,10 +87,17 @@ static void cell_state_message(const char *run_dir, const tcb_dataset_spec *d, c
     tcb_cell_free(&c);
 }
 
-static void cell_state(const char *run_dir, const tcb_dataset_spec *d, const char *seq, const tcb_method_spec *m,
-                       int seed, char *out, size_t size)
+static void cell_state(const char *run_dir, const tcb_run_opts *opts, const tcb_dataset_spec *d, const char *seq,
+                       const tcb_method_spec *m, int seed, char *out, size_t size)
 {
-    cell_state_message(run_dir, d, seq, m, seed, out, size, NULL, 0);
+    cell_state_message(run_dir, opts, d, seq, m, seed, out, size, NULL, 0);
+}
+
+/* A run computes the cell (a stale lock it takes over). */
+static int state_runs(const char *state)
+{
+    return !strcmp(state, "missing") || !strcmp(state, "unreadable") || !strcmp(state, "failed") ||
+           !strncmp(state, "stale", 5);
 }
 
 static void estimate_cell(const tcb_calibration_set *cals, const tcb_method_spec *m, const tcb_cost_query *q,
@@ -176,8 +187,8 @@ static int plan_cell(void *ctx, const tcb_grid_cell *c)
     tcb_cost_estimate e;
     estimate_cell(w->cals, c->method, &w->q, w->cfg->surface_samples, &e);
     char state[TCB_PATH_MAX];
-    cell_state(w->run_dir, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state);
-    int runs = w->opts->force || !strcmp(state, "missing") || !strcmp(state, "unreadable") || !strcmp(state, "failed");
+    cell_state(w->run_dir, w->opts, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state);
+    int runs = w->opts->force || state_runs(state);
     char fit[32], eval[32];
     duration_text(e.fit_s, fit, sizeof fit);
     duration_text(e.eval_s, eval, sizeof eval);
@@ -242,13 +253,14 @@ int tcb_run_dry(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_
 typedef struct list_walk {
     FILE *out;
     const char *run_dir;
+    const tcb_run_opts *opts;
 } list_walk;
 
 static int list_cell(void *ctx, const tcb_grid_cell *c)
 {
     const list_walk *w = ctx;
     char state[TCB_PATH_MAX];
-    cell_state(w->run_dir, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state);
+    cell_state(w->run_dir, w->opts, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state);
     fprintf(w->out, "%5d  %-12s %-20s %-24s %4d  %s\n", c->id, c->dataset->name, c->sequence->name,
             c->method->label, c->seed, state);
     return TCB_OK;
@@ -257,7 +269,7 @@ static int list_cell(void *ctx, const tcb_grid_cell *c)
 int tcb_run_list_cells(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_error *err)
 {
     (void)err;
-    list_walk w = {out, opts->output ? opts->output : cfg->output};
+    list_walk w = {out, opts->output ? opts->output : cfg->output, opts};
     fprintf(out, "%5s  %-12s %-20s %-24s %4s  %s\n", "id", "dataset", "sequence", "method", "seed", "state");
     return tcb_grid_for_each(cfg, list_cell, &w);
 }
@@ -273,9 +285,10 @@ typedef struct id_ranges {
 typedef struct status_walk {
     FILE *out;
     const char *run_dir;
+    const tcb_run_opts *opts;
     const tcb_slurm_queue *queue;
-    int n_done, n_diverged, n_failed, n_running, n_missing, n_queued;
-    id_ranges resubmit; /* the ids a run would compute (missing, failed, not queued) */
+    int n_done, n_diverged, n_failed, n_running, n_stale, n_missing, n_queued;
+    id_ranges resubmit; /* the ids a run would compute (missing, failed or stale, not queued) */
     id_ranges queued;
     char failures[8192];
 } status_walk;
@@ -297,21 +310,24 @@ static void add_id(id_ranges *r, int id)
 }
 
 /* A diverged cell is a result (listed, with why); a failed one has none
- * and is computed again by the next run, as a missing one is, unless a
- * Slurm task that will run it is queued. */
+ * and is computed again by the next run, as a missing one is, or one whose
+ * lock is stale, unless a Slurm task that will run it is queued. */
 static int status_cell(void *ctx, const tcb_grid_cell *c)
 {
     status_walk *w = ctx;
     char state[TCB_PATH_MAX], msg[TCB_ERRMSG_MAX];
-    cell_state_message(w->run_dir, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state, msg,
-                       sizeof msg);
+    cell_state_message(w->run_dir, w->opts, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state,
+                       msg, sizeof msg);
     int missing = !strcmp(state, "missing") || !strcmp(state, "unreadable"), failed = !strcmp(state, "failed");
-    int queued = (missing || failed) && w->queue->queued && w->queue->queued[c->id];
+    int running = !strncmp(state, "running", 7), stale = !strncmp(state, "stale", 5);
+    int queued = state_runs(state) && w->queue->queued && w->queue->queued[c->id];
     if (!strcmp(state, "done")) w->n_done++;
-    else if (!strncmp(state, "running", 7)) {
-        w->n_running++;
-        fprintf(w->out, "running  %5d  %s/%s/%s seed %d: %s\n", c->id, c->dataset->name, c->sequence->name,
-                c->method->label, c->seed, state + 8);
+    else if (running || stale) {
+        w->n_running += running;
+        w->n_stale += stale && !queued;
+        fprintf(w->out, "%-8s %5d  %s/%s/%s seed %d: %s%s\n", running ? "running" : "stale", c->id, c->dataset->name,
+                c->sequence->name, c->method->label, c->seed, strchr(state, '('),
+                queued ? " (queued again in Slurm)" : "");
     } else if (!missing) {
         w->n_failed += failed && !queued;
         w->n_diverged += !failed;
@@ -323,7 +339,7 @@ static int status_cell(void *ctx, const tcb_grid_cell *c)
     w->n_missing += missing && !queued;
     w->n_queued += queued;
     if (queued) add_id(&w->queued, c->id);
-    else if (missing || failed) add_id(&w->resubmit, c->id);
+    else if (state_runs(state)) add_id(&w->resubmit, c->id);
     return TCB_OK;
 }
 
@@ -335,7 +351,7 @@ int tcb_run_status(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, t
     if (tcb_slurm_queue_read(run_dir, tcb_grid_count(cfg), &queue, note, sizeof note))
         return tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
     if (note[0]) tcb_report_log(&opts->reporter, TCB_LOG_WARN, "%s", note);
-    status_walk w = {.out = out, .run_dir = run_dir, .queue = &queue, .resubmit = {-1, -1, ""}, .queued = {-1, -1, ""}};
+    status_walk w = {.out = out, .run_dir = run_dir, .opts = opts, .queue = &queue, .resubmit = {-1, -1, ""}, .queued = {-1, -1, ""}};
     tcb_grid_for_each(cfg, status_cell, &w);
     flush_range(&w.resubmit);
     flush_range(&w.queued);
@@ -343,13 +359,13 @@ int tcb_run_status(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, t
     if (w.n_queued)
         fprintf(out, "queued   %s: pending or running in Slurm (%s %s)\n", w.queued.text,
                 strchr(queue.jobs, ' ') ? "jobs" : "job", queue.jobs);
-    fprintf(out, "%s: %d cells: %d done, %d diverged, %d failed, %d running, %d missing", w.run_dir,
-            tcb_grid_count(cfg), w.n_done, w.n_diverged, w.n_failed, w.n_running, w.n_missing);
+    fprintf(out, "%s: %d cells: %d done, %d diverged, %d failed, %d running, %d stale, %d missing", w.run_dir,
+            tcb_grid_count(cfg), w.n_done, w.n_diverged, w.n_failed, w.n_running, w.n_stale, w.n_missing);
     if (queue.asked) fprintf(out, ", %d queued in Slurm", w.n_queued);
     fprintf(out, "\n");
-    if (w.n_missing || w.n_failed)
-        fprintf(out, "resubmit the cells a run computes (%d missing, %d failed): --array=%s\n", w.n_missing,
-                w.n_failed, w.resubmit.text);
+    if (w.n_missing || w.n_failed || w.n_stale)
+        fprintf(out, "resubmit the cells a run computes (%d missing, %d failed, %d stale): --array=%s\n", w.n_missing,
+                w.n_failed, w.n_stale, w.resubmit.text);
     tcb_slurm_queue_free(&queue);
     return TCB_OK;
 }

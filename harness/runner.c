@@ -63,6 +63,11 @@ int tcb_run_selected(const tcb_run_opts *opts, const tcb_method_spec *m)
     return !opts->only_method || strcmp(opts->only_method, m->label) == 0;
 }
 
+double tcb_run_lock_timeout(const tcb_run_opts *opts)
+{
+    return opts->lock_timeout_s > 0 ? opts->lock_timeout_s : TCB_LOCK_TIMEOUT_DEFAULT_S;
+}
+
 /* Every selected method must exist and accept its params before any work
  * starts: a typo should cost seconds, not the hours of the cells before it. */
 int tcb_run_check_methods(const tcb_config *cfg, const tcb_run_opts *opts, tcb_error *err)
@@ -288,7 +293,7 @@ static int clear_stale_lock(const run_state *st, const char *path, tcb_error *er
     if (tcb_cell_lock_holder(path, &holder)) return TCB_OK;
     tcb_cell_lock lock;
     char note[512];
-    double timeout = st->opts->lock_timeout_s > 0 ? st->opts->lock_timeout_s : TCB_LOCK_TIMEOUT_DEFAULT_S;
+    double timeout = tcb_run_lock_timeout(st->opts);
     int rc = tcb_cell_lock_acquire(&lock, path, timeout, &holder, note, sizeof note, err);
     tcb_cell_lock_release(&lock);
     return rc;
@@ -320,7 +325,7 @@ static int claim_and_run(const run_state *st, const seq_ctx *sc, const tcb_metho
     tcb_cell_lock lock;
     tcb_lock_info holder;
     char note[512], label[TCB_CELL_LABEL_MAX];
-    double timeout = st->opts->lock_timeout_s > 0 ? st->opts->lock_timeout_s : TCB_LOCK_TIMEOUT_DEFAULT_S;
+    double timeout = tcb_run_lock_timeout(st->opts);
     tcb_cell_label(label, sizeof label, sc->dataset->name, sc->seq->name, m->label, seed);
     rc = tcb_cell_lock_acquire(&lock, path, timeout, &holder, note, sizeof note, err);
     if (rc) return rc;

@@ -72,15 +72,15 @@ grep -q "queued" out.txt && { echo "FAIL: status asked squeue about a run never 
 echo "2026-12-03T00:00:00Z g.json" > queue/slurm-submissions.log
 PATH="$tmp/fake:$PATH" expect 0 "" "$TCBENCH" status g.json --out queue
 grep -qxF "queued   1-2,6: pending or running in Slurm (jobs 57 58)" out.txt &&
-    grep -qxF "queue: 8 cells: 2 done, 0 diverged, 0 failed, 0 running, 3 missing, 3 queued in Slurm" out.txt &&
-    grep -qxF "resubmit the cells a run computes (3 missing, 0 failed): --array=4-5,7" out.txt || { cat out.txt; exit 1; }
+    grep -qxF "queue: 8 cells: 2 done, 0 diverged, 0 failed, 0 running, 0 stale, 3 missing, 3 queued in Slurm" out.txt &&
+    grep -qxF "resubmit the cells a run computes (3 missing, 0 failed, 0 stale): --array=4-5,7" out.txt || { cat out.txt; exit 1; }
 # squeue failing: a warning, and the counts as without it; no squeue: nothing.
 printf '#!/bin/sh\necho "squeue: error: Unable to contact slurm controller" >&2\nexit 1\n' > fake/squeue
 PATH="$tmp/fake:$PATH" expect 0 "warning: squeue failed (squeue: error: Unable to contact slurm controller), so cells queued in Slurm count as missing" \
     "$TCBENCH" status g.json --out queue
-grep -qxF "queue: 8 cells: 2 done, 0 diverged, 0 failed, 0 running, 6 missing" out.txt || { cat out.txt; exit 1; }
+grep -qxF "queue: 8 cells: 2 done, 0 diverged, 0 failed, 0 running, 0 stale, 6 missing" out.txt || { cat out.txt; exit 1; }
 PATH=/nonexistent "$TCBENCH" status g.json --out queue > out.txt 2> err.txt
-[ ! -s err.txt ] && grep -qxF "resubmit the cells a run computes (6 missing, 0 failed): --array=1-2,4-7" out.txt ||
+[ ! -s err.txt ] && grep -qxF "resubmit the cells a run computes (6 missing, 0 failed, 0 stale): --array=1-2,4-7" out.txt ||
     { cat out.txt err.txt; exit 1; }
 
 # submit.sh finds tcbench ($TCBENCH, else the checkout's build/tcbench, else

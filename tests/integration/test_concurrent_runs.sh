@@ -84,9 +84,32 @@ grep -qF "cells: 12 in all, 11 computed, 0 already done, 0 failed, 1 running in 
 "$TCBENCH" cells grid.json --out foreign > cells.txt
 grep -qE "nearest +1  running \(node-17 pid 4242, heartbeat [0-9]+ s ago\)" cells.txt || { cat cells.txt; exit 1; }
 touch -d '-2 minutes' "$cell.lock"
+# Older than --lock-timeout: stale, and the next run computes it.
+"$TCBENCH" cells grid.json --out foreign --lock-timeout 60 > cells.txt
+grep -qE "nearest +1  stale \(node-17 pid 4242: its heartbeat stopped, heartbeat 1[0-9]{2} s ago\)" cells.txt ||
+    { cat cells.txt; exit 1; }
+"$TCBENCH" status foreign --lock-timeout 60 > status.txt
+grep -qE "^stale +[0-9]+  synth/quadruped_walk/nearest seed 1: \(node-17 pid 4242: its heartbeat stopped" status.txt &&
+    grep -qF "1 running, 0 stale" <("$TCBENCH" status foreign) &&
+    grep -qE "^resubmit the cells a run computes \(0 missing, 0 failed, 1 stale\): --array=[0-9]+$" status.txt ||
+    { cat status.txt; exit 1; }
 "$TCBENCH" run grid.json --out foreign --lock-timeout 60 2> stale.log
 grep -qF "took over the lock of node-17 pid 4242: its heartbeat stopped" stale.log || { cat stale.log; exit 1; }
 same_cells plain foreign
+
+# A holder of this host that is gone (killed, its machine restarted) is
+# stale at once, whatever its heartbeat's age.
+cell=gone/cells/synth/quadruped_walk/nearest/seed_2.json
+mkdir -p "$(dirname "$cell")"
+sleep 0 & dead=$!
+wait $dead
+printf '{"host": "%s", "pid": %d, "started": 1.5}' "$(uname -n)" "$dead" > "$cell.lock"
+"$TCBENCH" cells grid.json --out gone > cells.txt
+grep -qE "nearest +2  stale \(.* pid $dead: its process is gone, heartbeat [0-9]+ s ago\)" cells.txt ||
+    { cat cells.txt; exit 1; }
+"$TCBENCH" run grid.json --out gone 2> gone.log
+grep -qF "took over the lock of $(uname -n) pid $dead: its process is gone" gone.log || { cat gone.log; exit 1; }
+same_cells plain gone
 
 # A live holder's progress: each heartbeat (every --lock-timeout/4 s) notes
 # it beside the lock, `cells` shows it, and it goes with the lock.

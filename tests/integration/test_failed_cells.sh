@@ -61,10 +61,10 @@ assert c("nearest", 1)["status"] == "ok"
 PY
 
 expect 0 "2 failed" "$TCBENCH" status run
-grep -qF "run: 5 cells: 2 done, 1 diverged, 2 failed, 0 running, 0 missing" out.txt || { cat out.txt; exit 1; }
+grep -qF "run: 5 cells: 2 done, 1 diverged, 2 failed, 0 running, 0 stale, 0 missing" out.txt || { cat out.txt; exit 1; }
 grep -qE "^failed +2  synth/quadruped_walk/mine seed 0: fit: .*line 15$" out.txt || { cat out.txt; exit 1; }
 grep -qE "^diverged +4  synth/quadruped_walk/unstable seed 0: " out.txt || { cat out.txt; exit 1; }
-grep -qF "resubmit the cells a run computes (0 missing, 2 failed): --array=2-3" out.txt || { cat out.txt; exit 1; }
+grep -qF "resubmit the cells a run computes (0 missing, 2 failed, 0 stale): --array=2-3" out.txt || { cat out.txt; exit 1; }
 expect 0 "" "$TCBENCH" run grid.json --dry-run
 grep -qF "cells: 5, 3 finished, 2 to run" out.txt || { cat out.txt; exit 1; }
 

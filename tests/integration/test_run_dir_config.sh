@@ -76,7 +76,7 @@ expect 0 "cells: 3 in all, 3 computed, 0 already done" "$TCBENCH" run seed.json 
 # The record is the union: the cells of the methods, sequences and datasets
 # a config leaves out stay recorded; status reads it.
 # (the union's grid: cells neither config asked for are missing)
-expect 0 "grow: 28 cells: 19 done, 0 diverged, 0 failed, 0 running, 9 missing" "$TCBENCH" status grow
+expect 0 "grow: 28 cells: 19 done, 0 diverged, 0 failed, 0 running, 0 stale, 9 missing" "$TCBENCH" status grow
 /usr/bin/python3 - <<'PY'
 import json
 r = json.load(open("grow/config.json"))

@@ -80,8 +80,8 @@ for _ in $(seq 100); do [ -z "$(squeue -h -j "${job}_2" 2> /dev/null)" ] && brea
 # Cells 1 and 3 are queued (their tasks wait), cell 2 missing (cancelled).
 "$TCBENCH" status long.json --out long > status.txt
 grep -qxF "queued   1,3: pending or running in Slurm (job $job)" status.txt &&
-    grep -qF "long: 4 cells: 1 done, 0 diverged, 0 failed, 0 running, 1 missing, 2 queued in Slurm" status.txt &&
-    grep -qxF "resubmit the cells a run computes (1 missing, 0 failed): --array=2" status.txt ||
+    grep -qF "long: 4 cells: 1 done, 0 diverged, 0 failed, 0 running, 0 stale, 1 missing, 2 queued in Slurm" status.txt &&
+    grep -qxF "resubmit the cells a run computes (1 missing, 0 failed, 0 stale): --array=2" status.txt ||
     { echo "FAIL: status"; cat status.txt; squeue -r; exit 1; }
 TCBENCH="$TCBENCH" "$TCB_SOURCE_DIR/scripts/slurm/submit.sh" long.json --out "$tmp/long" \
     --sbatch "-c 1 -o $tmp/again-%a.log" > submit-again.txt 2>&1 || { cat submit-again.txt; exit 1; }
