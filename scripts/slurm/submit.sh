@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Submits a tcbench config as a Slurm job array over the cells a run would
-# compute (missing and failed ones, less those already queued).
+# compute (missing, failed and stale ones, less those already queued).
 #   scripts/slurm/submit.sh CONFIG [--tasks N] [--max-running K] [--sbatch "ARGS"] [tcbench run options...]
 # Without --tasks: one array task per cell (the array's indices are the cell
 # ids, so the largest id must be below the cluster's MaxArraySize). With
