@@ -19,7 +19,8 @@
 #include "tcb/synth.h"
 
 typedef struct plan_totals {
-    int cells, done, to_run, unknown;  /* unknown: cells to run with a part not estimated */
+    int cells, done, running, to_run;  /* running: held by a live process elsewhere */
+    int unknown;                       /* cells to run with a part not estimated */
     double seconds;  /* the estimated parts of the cells to run */
     double *cell_s;  /* [to_run] each one's estimated seconds, in id order (--tasks) */
     int cap;
@@ -192,11 +193,14 @@ static int plan_cell(void *ctx, const tcb_grid_cell *c)
     char fit[32], eval[32];
     duration_text(e.fit_s, fit, sizeof fit);
     duration_text(e.eval_s, eval, sizeof eval);
-    fprintf(w->out, "  %4d  %-24s %4d  %-10s %9s %9s  %s\n", c->id, c->method->label, c->seed, state, fit, eval,
+    /* The state's first word: the holder of a running cell is `status`'s to show. */
+    fprintf(w->out, "  %4d  %-24s %4d  %-10.*s %9s %9s  %s\n", c->id, c->method->label, c->seed,
+            (int)strcspn(state, " "), state, fit, eval,
             e.basis);
     w->t.cells++;
     if (!runs) {
-        w->t.done++;
+        if (!strncmp(state, "running", 7)) w->t.running++;
+        else w->t.done++;
         return TCB_OK;
     }
     w->t.to_run++;
@@ -219,8 +223,9 @@ static void print_totals(FILE *out, const plan_totals *t, int tasks)
 {
     char total[32];
     duration_text(t->seconds, total, sizeof total);
-    fprintf(out, "cells: %d, %d finished, %d to run: about %s of wall time one after another", t->cells, t->done,
-            t->to_run, total);
+    fprintf(out, "cells: %d, %d finished, ", t->cells, t->done);
+    if (t->running) fprintf(out, "%d running in other processes, ", t->running);
+    fprintf(out, "%d to run: about %s of wall time one after another", t->to_run, total);
     if (t->unknown)
         fprintf(out, ", plus what is unknown of %d cell%s (\"?\" above)", t->unknown, t->unknown == 1 ? "" : "s");
     fprintf(out, "\n");

@@ -83,6 +83,9 @@ grep -qF "cells: 12 in all, 11 computed, 0 already done, 0 failed, 1 running in 
     { cat fresh.log; exit 1; }
 "$TCBENCH" cells grid.json --out foreign > cells.txt
 grep -qE "nearest +1  running \(node-17 pid 4242, heartbeat [0-9]+ s ago\)" cells.txt || { cat cells.txt; exit 1; }
+"$TCBENCH" run grid.json --out foreign --dry-run > dry.txt
+grep -qE "^ +1  nearest +1  running +[0-9.]+ s" dry.txt &&
+    grep -qF "cells: 12, 11 finished, 1 running in other processes, 0 to run" dry.txt || { cat dry.txt; exit 1; }
 touch -d '-2 minutes' "$cell.lock"
 # Older than --lock-timeout: stale, and the next run computes it.
 "$TCBENCH" cells grid.json --out foreign --lock-timeout 60 > cells.txt
