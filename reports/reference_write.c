@@ -119,6 +119,42 @@ static void md_group(FILE *f, const tcb_ref_cmp_table *t, const tcb_ref_group *g
         if (t->shown[m]) md_orderings(f, g, m);
 }
 
+/* A row of block blk is in the paper when a row of these tables names it,
+ * or names its method in its dataset's MEAN (the paper's row pools it). */
+static int row_in_paper(const tcb_ref_cmp *c, const tcb_rpt_block *blk, const tcb_rpt_row *row)
+{
+    for (int k = 0; k < c->n_tables; k++)
+        for (int g = 0; g < c->tables[k].n_groups; g++) {
+            const tcb_ref_group *gr = &c->tables[k].groups[g];
+            int pooled = !strcmp(gr->sequence, "MEAN") && !strcmp(gr->dataset, blk->dataset);
+            for (int r = 0; r < gr->n_rows; r++) {
+                const tcb_rpt_row *ours = gr->rows[r].ours;
+                if (ours == row || (pooled && ours && !strcmp(ours->method, row->method))) return 1;
+            }
+        }
+    return 0;
+}
+
+/* The run's cells that no row of these tables names (a method the paper
+ * did not run, a sequence it did not report), so that a reader looks for
+ * them in tables.md rather than taking them as left out. */
+static void md_not_in_paper(FILE *f, const tcb_ref_cmp *c)
+{
+    int any = 0;
+    for (int b = 0; b < c->run->n_blocks; b++) {
+        const tcb_rpt_block *blk = &c->run->blocks[b];
+        int first = 1;
+        for (int r = 0; r < blk->n_rows; r++) {
+            if (row_in_paper(c, blk, &blk->rows[r])) continue;
+            if (!any) fprintf(f, "\nIn the run but in no row of these tables (tables.md has them):\n\n");
+            if (first) fprintf(f, "- %s / %s: ", blk->dataset, blk->sequence);
+            fprintf(f, "%s%s", first ? "" : ", ", blk->rows[r].method);
+            any = 1, first = 0;
+        }
+        if (!first) fprintf(f, "\n");
+    }
+}
+
 static void write_md(FILE *f, const tcb_ref_cmp *c)
 {
     fprintf(f, "# Beside the paper: %s\n\n%s\n\n", c->ref->name, c->ref->paper);
@@ -130,6 +166,7 @@ static void write_md(FILE *f, const tcb_ref_cmp *c)
         if (t->n_absent) fprintf(f, "\n%d more group%s of this table not in the run.\n", t->n_absent,
                                  t->n_absent == 1 ? "" : "s");
     }
+    md_not_in_paper(f, c);
 }
 
 /* ---- LaTeX ------------------------------------------------------------- */

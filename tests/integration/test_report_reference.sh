@@ -42,6 +42,7 @@ grep -qE "^\| row oracle \| oracle \| 0\.00 ± 0\.00 \| [0-9.]+ ± 2\.00 \| 0\.0
 grep -qF "†: ours beyond 1.5× the paper's" out.txt || { echo "FAIL: no legend of †"; cat out.txt; exit 1; }
 grep -qF "Presets" out.txt && { echo "FAIL: no row names a preset"; cat out.txt; exit 1; }
 grep -qF "| row absent | absent | not run |" out.txt || { echo "FAIL: absent row"; cat out.txt; exit 1; }
+grep -qF "In the run but in no row" out.txt && { echo "FAIL: every cell has a row"; cat out.txt; exit 1; }
 # 30 pairs: the oracle's lead is significant, so the paper's order flips for real.
 grep -qF -- "- m_sL2 ↓: 1 ordering: agrees 0, flips (significant) 1, flips (within noise) 0" out.txt &&
 grep -qF -- "  - the paper has row nearest better than row oracle: flips (significant)" out.txt ||
@@ -73,6 +74,17 @@ import csv
 far = {r["method"]: r["beyond_1_5x"] for r in csv.DictReader(open("near14/reference_toy.csv")) if r["metric"] == "sl2"}
 assert far == {"oracle": "1", "nearest": "0", "absent": "0"}, far
 PY
+
+# A cell of a method the paper did not run is named below the tables.
+/usr/bin/python3 - <<'PY'
+import json
+ref = json.load(open("toy.json"))
+del ref["tables"][1]["rows"][1]
+json.dump(ref, open("toy_no_nearest.json", "w"))
+PY
+expect 0 "- synth / quadruped_walk: nearest" "$TCBENCH" report run --reference toy_no_nearest.json --out no_nearest
+grep -qF "In the run but in no row of these tables (tables.md has them):" out.txt &&
+    ! grep -qE "^- synth / quadruped_walk: .*oracle" out.txt || { echo "FAIL: cells without a row"; cat out.txt; exit 1; }
 
 # A run whose cells name a preset other than `paper` says so above its
 # tables, in the reference report, tables.md and tables.tex.
