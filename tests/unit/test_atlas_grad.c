@@ -11,7 +11,9 @@
  * where max_T is over the whole tensor (the floor covers entries that are
  * small by cancellation, where float rounding is relatively larger). The
  * objective L = Σ a·φ + Σ b·φ_u + Σ c·φ_v with random a, b, c exercises the
- * reverse mode through the tangents, softplus′′ included. */
+ * reverse mode through the tangents, softplus′′ included. The shared
+ * layers of neural/ are checked here too (Linear, ReLU, LeakyReLU: the
+ * last is neupig's MLP's). */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -226,31 +228,47 @@ typedef struct {
     double *x;
     const double *w;
     int n;
+    double slope; /* 0: ReLU; > 0: LeakyReLU */
 } relu_ctx;
 
 static double relu_objective(void *p)
 {
     relu_ctx *c = p;
     double sum = 0.0;
-    for (int i = 0; i < c->n; i++) sum += c->w[i] * fmax(c->x[i], 0.0);
+    for (int i = 0; i < c->n; i++) sum += c->w[i] * (c->x[i] > 0 ? c->x[i] : c->slope * c->x[i]);
     return sum;
 }
 
-static void test_relu(void **state)
+/* ReLU (slope 0, the atlas decoders) and LeakyReLU (neupig's MLP, slope
+ * 0.01): forward exact, backward against central differences. */
+static void check_relu(float slope)
 {
-    (void)state;
     enum { n = 64 };
     tcb_rng rng;
     tcb_rng_seed_stream(&rng, 1, "test/atlas/relu");
     float x[n], y[n], w[n], dx[n];
     tu_fill_uniform(&rng, x, n, -1, 1);
     tu_fill_uniform(&rng, w, n, -1, 1);
-    tcb_relu_forward(y, x, n);
-    relu_ctx c = {tu_to_double(x, n), tu_to_double(w, n), n};
-    for (int i = 0; i < n; i++) assert_true(y[i] == (x[i] > 0 ? x[i] : 0.0f));
-    tcb_relu_backward(dx, w, y, n);
-    check_grad("relu dx", relu_objective, &c, c.x, dx, n, n, &rng);
+    if (slope > 0) tcb_leaky_relu_forward(y, x, n, slope);
+    else tcb_relu_forward(y, x, n);
+    relu_ctx c = {tu_to_double(x, n), tu_to_double(w, n), n, slope};
+    for (int i = 0; i < n; i++) assert_true(y[i] == (x[i] > 0 ? x[i] : slope * x[i]));
+    if (slope > 0) tcb_leaky_relu_backward(dx, w, y, n, slope);
+    else tcb_relu_backward(dx, w, y, n);
+    check_grad(slope > 0 ? "leaky relu dx" : "relu dx", relu_objective, &c, c.x, dx, n, n, &rng);
     free(c.x), free((void *)c.w);
+}
+
+static void test_relu(void **state)
+{
+    (void)state;
+    check_relu(0.0f);
+}
+
+static void test_leaky_relu(void **state)
+{
+    (void)state;
+    check_relu(0.01f);
 }
 
 typedef struct {
@@ -637,7 +655,7 @@ static void test_model_grad(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_linear),          cmocka_unit_test(test_relu),
+        cmocka_unit_test(test_linear),          cmocka_unit_test(test_relu), cmocka_unit_test(test_leaky_relu),
         cmocka_unit_test(test_softplus),        cmocka_unit_test(test_maxpool),
         cmocka_unit_test(test_decoder_tangents), cmocka_unit_test(test_decoder_grad),
         cmocka_unit_test(test_encoder_grad),    cmocka_unit_test(test_model_grad),
