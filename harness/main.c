@@ -614,7 +614,7 @@ static const command commands[] = {
      "  tcbench run configs/quick.json --out runs/quick --report\n"
      "  tcbench run configs/paper/table5-nricp.json --root ama=../shared/data/ama --dry-run\n"},
     {"cells", cmd_cells, BIT(F_OUT) | BIT(F_ROOT) | BIT(F_VARIANT) | BIT(F_LOCK_TIMEOUT), 1, 1, "CONFIG",
-     "usage: tcbench cells CONFIG [--variant NAME] [--root DATASET=DIR]... [--out DIR]\n"
+     "usage: tcbench cells CONFIG [--variant NAME] [--root DATASET=DIR]... [--out DIR] [--lock-timeout S]\n"
      "\n"
      "Lists the config's cells, numbered in one fixed order (datasets, sequences,\n"
      "methods, seeds) that depends only on the config, with each cell's state in the\n"

@@ -195,8 +195,7 @@ static int plan_cell(void *ctx, const tcb_grid_cell *c)
     duration_text(e.eval_s, eval, sizeof eval);
     /* The state's first word: the holder of a running cell is `status`'s to show. */
     fprintf(w->out, "  %4d  %-24s %4d  %-10.*s %9s %9s  %s\n", c->id, c->method->label, c->seed,
-            (int)strcspn(state, " "), state, fit, eval,
-            e.basis);
+            (int)strcspn(state, " "), state, fit, eval, e.basis);
     w->t.cells++;
     if (!runs) {
         if (!strncmp(state, "running", 7)) w->t.running++;
