@@ -16,7 +16,7 @@ cmake --build build-test -j"$(nproc)" >/dev/null
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DTCB_BUILD_TESTS=OFF >/dev/null
 cmake --build build -j"$(nproc)" >/dev/null
 # The fuzz targets (fuzz/README.md), built by clang with libFuzzer: each
-# searches for TCB_FUZZ_SMOKE_S (20) seconds from its seeds, after the
+# searches for TCB_FUZZ_SMOKE_S (10) seconds from its seeds, after the
 # suite. (The sanitized build above replays their seeds and regressions.)
 CC=clang cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTCB_FUZZ=ON -DTCB_BUILD_TESTS=OFF >/dev/null
 cmake --build build-fuzz -j"$(nproc)" --target fuzz_targets >/dev/null
