@@ -931,6 +931,7 @@ static const char general_help[] =
     "  cells     the numbered cells of a config and their state\n"
     "  status    where a run stands; the missing cells as a Slurm --array list\n"
     "  report    tables and plots from a run directory\n"
+    "  compare   is the difference between two methods real? interval and p per metric\n"
     "  methods   list the registered methods\n"
     "  datasets  list or export the synthetic sequences, align an OBJ sequence's rotations\n"
     "  check     compare a run with a baseline (CI regression check)\n"
