@@ -27,7 +27,7 @@
 #include "tests/support/bent_tube.h"
 #include "tcb/geodesic.h"
 #include "tcb/geometry.h"
-#include "tcb/mesh.h"
+#include "tcb/mesh_io.h"
 #include "tcb/nn.h"
 #include "tcb/rng.h"
 

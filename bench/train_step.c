@@ -13,7 +13,7 @@
  * C: the method's own training steps (train_steps, created with {"preset":
  * P}) on the calibration sequence (synthetic, 6 frames, pools of 10,000
  * points), one warm-up step, then the mean of `iters` steps: the
- * measurement `tcbench calibrate` makes (harness/step_timing.c). The PyTorch peer runs after the C
+ * measurement `tcbench calibrate` makes (costs/step_timing.c). The PyTorch peer runs after the C
  * rows of the same (preset, method), with the same sizes, thread count and
  * warm-up; the C process waits meanwhile.
  *
@@ -71,8 +71,8 @@
 
 #include "atlas_bench.h"
 #include "cc_bench.h"
-#include "harness/calibration.h"
-#include "tcb/mesh.h"
+#include "costs/step_timing.h"
+#include "tcb/mesh_io.h"
 #include "tcb/registry.h"
 
 enum { P = 10, N = TCB_DEFAULT_INPUT_POINTS, PEER_SKIPPED = 77 };

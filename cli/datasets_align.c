@@ -8,8 +8,8 @@
  * loads them, so the file lists the rotations a run applies. */
 #include <stdlib.h>
 
+#include "cli/datasets.h"
 #include "datasets/objdir.h"
-#include "harness/internal.h"
 #include "tcb/align.h"
 #include "tcb/json.h"
 #include "tcb/report.h"

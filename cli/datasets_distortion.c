@@ -5,8 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli/datasets.h"
 #include "datasets/objdir.h"
-#include "harness/internal.h"
 #include "tcb/distortion.h"
 #include "tcb/fsutil.h"
 #include "tcb/synth.h"

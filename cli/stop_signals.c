@@ -9,7 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "harness/internal.h"
+#include "cli/stop_signals.h"
 
 static void *wait_for_signal(void *arg)
 {

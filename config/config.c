@@ -9,7 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/internal.h"
+#include "config/config_internal.h"
+#include "tcb/metrics.h"
 #include "tcb/align.h"
 #include "tcb/json.h"
 #include "tcb/synth.h"

@@ -3,7 +3,8 @@
 #include <cjson/cJSON.h>
 #include <string.h>
 
-#include "harness/internal.h"
+#include "tcb/config.h"
+#include "tcb/metrics.h"
 
 static cJSON *dump_evaluation(const tcb_config *c)
 {

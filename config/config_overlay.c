@@ -15,7 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/internal.h"
+#include "config/config_internal.h"
 #include "tcb/json.h"
 
 static const char *const variant_keys[] = {"seeds", "params", NULL};

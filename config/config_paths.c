@@ -23,7 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/internal.h"
+#include "config/config_internal.h"
 #include "tcb/fsutil.h"
 
 /* The config file's directory, absolute, in dir; 0 when origin names no

@@ -1,6 +1,8 @@
 /* Facts about the running tcbench recorded in every cell: the source
  * revision (so a result can be traced to code) and the peak memory; and
  * the machine a calibration names. */
+#include "tcb/sysinfo.h"
+
 #include <cblas.h>
 #include <cjson/cJSON.h>
 #include <omp.h>
@@ -11,8 +13,7 @@
 #include <sys/utsname.h>
 #include <time.h>
 
-#include "harness/internal.h"
-#include "tcb/tcb.h"
+#include "tcb/version.h"
 
 void tcb_git_revision(char *out, size_t size)
 {

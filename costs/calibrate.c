@@ -1,5 +1,5 @@
 /* `tcbench calibrate`: the costs the dry run prices cells with, measured on
- * this machine (harness/calibration.h).
+ * this machine (costs/calibration.h).
  *
  * Every registered method with train_steps or units, at each of its
  * presets (one without presets: once, created with "{}") and each thread
@@ -16,10 +16,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/calibration.h"
-#include "harness/internal.h"
+#include "costs/calibrate.h"
+#include "costs/calibration.h"
+#include "costs/step_timing.h"
 #include "tcb/fsutil.h"
 #include "tcb/registry.h"
+#include "tcb/sysinfo.h"
 
 enum {
     MAX_STEPS = 50, QUICK_MAX_STEPS = 5, EVAL_PAIRS = 6, QUICK_EVAL_PAIRS = 1,

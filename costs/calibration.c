@@ -1,4 +1,4 @@
-/* Calibration files (harness/calibration.h): read, written, and found.
+/* Calibration files (costs/calibration.h): read, written, and found.
  *
  * {"format": "tcbench-calibration 1",
  *  "machine": {"summary": "CPU model, N cores", "cpu": ..., "cores": ..., ...},
@@ -13,7 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/calibration.h"
+#include "costs/calibration.h"
 #include "tcb/fsutil.h"
 #include "tcb/json.h"
 

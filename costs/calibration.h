@@ -16,11 +16,13 @@
  *   - the harness's scoring of a pair: projection, metrics, geodesic error
  *     (kind score_pair, no method),
  * each at the thread counts measured, on the calibration sequence
- * (tcb_calibration_sequence), whose vertex and frame counts it records. */
-#ifndef TCB_HARNESS_CALIBRATION_H
-#define TCB_HARNESS_CALIBRATION_H
-
-#include <stdio.h>
+ * (tcb_calibration_sequence), whose vertex and frame counts it records.
+ *
+ * The face of costs/ for the dry run (harness/plan.c) and the command line:
+ * the file, the set a dry run reads, and pricing. Measuring is
+ * costs/step_timing.h, the command costs/calibrate.h. */
+#ifndef TCB_COSTS_CALIBRATION_H
+#define TCB_COSTS_CALIBRATION_H
 
 #include "tcb/method.h"
 #include "tcb/sequence.h"
@@ -114,57 +116,5 @@ int tcb_cost_lookup(const tcb_calibration_set *s, const tcb_cost_key *key, int t
  * -1, and basis says which command measures them. */
 void tcb_cost_price_cell(const tcb_calibration_set *s, const char *method, const tcb_cost_query *q,
                          int surface_samples, tcb_cost_estimate *e);
-
-/* ---- measuring (harness/step_timing.c) ---- */
-
-/* The sequence costs are measured on: synthetic quadruped_walk,
- * TCB_CALIBRATION_FRAMES frames,
- * pools of TCB_DEFAULT_POOL_SIZE points, clouds of TCB_DEFAULT_INPUT_POINTS
- * (bench_train_step's too). */
-int tcb_calibration_sequence(tcb_sequence *s, tcb_error *err);
-
-/* Times train_steps of a created method on seq with ctx->n_threads OpenMP
- * threads (set here): one warm-up step (its seconds, the training's setup
- * included, in first_s), then steps until max_steps or until budget_s is
- * spent, warm-up included, at least one; step_s is their mean. */
-typedef struct tcb_step_timing {
-    double first_s, step_s;
-    int steps;
-} tcb_step_timing;
-int tcb_time_train_steps(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx,
-                         int max_steps, double budget_s, tcb_step_timing *out, tcb_error *err);
-
-/* Times run_unit(unit) as tcb_time_train_steps times steps: an untimed
- * first run, then runs until max_runs or budget_s. */
-int tcb_time_unit(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, int unit,
-                  int max_runs, double budget_s, tcb_step_timing *out, tcb_error *err);
-
-/* Times the reconstruction metrics of a frame of a method trained by
- * train_steps, on frames of seq until max_frames or until budget_s is
- * spent, at least one, no warm-up (first_s 0): *mesh_s the mean of the
- * method's surface, step_s the harness's part at `samples` per mesh (both
- * sample sets and the metrics, on the GT meshes of two frames). */
-int tcb_time_surface_frames(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, int max_frames,
-                            double budget_s, int samples, tcb_step_timing *out, double *mesh_s, tcb_error *err);
-
-/* Mean seconds per pair over n pairs of seq, after one untimed, of a
- * method trained by train_steps: its part (transfer, reconstructions and their Chamfer
- * distances) and the harness's scoring of its transfer. */
-int tcb_time_eval_pairs(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, int n, double *method_s,
-                        double *score_s, tcb_error *err);
-
-/* ---- the command (harness/calibrate.c) ---- */
-
-typedef struct tcb_calibrate_opts {
-    const int *threads;    /* thread counts to measure, increasing */
-    int n_threads;
-    const char *method;    /* NULL: every method with train_steps */
-    const char *preset;    /* NULL: each of its presets */
-    double budget_s;       /* the whole measurement's */
-    int quick;             /* fewer steps and pairs: a coarse pass */
-    int surface_samples;   /* per mesh, of the reconstruction metrics measured */
-    const char *out_path;
-} tcb_calibrate_opts;
-int tcb_calibrate(const tcb_calibrate_opts *o, FILE *out, tcb_error *err);
 
 #endif

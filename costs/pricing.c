@@ -1,10 +1,10 @@
-/* A cell's cost from the calibrations (harness/calibration.h): a cost at
+/* A cell's cost from the calibrations (costs/calibration.h): a cost at
  * any thread count from the counts measured, and a method's estimate
  * priced with it. */
 #include <math.h>
 #include <string.h>
 
-#include "harness/calibration.h"
+#include "costs/calibration.h"
 
 #define MAX_COUNTS 64 /* thread counts of one (kind, method, preset) */
 

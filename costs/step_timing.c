@@ -1,12 +1,13 @@
 /* Timing a method's training steps, units, evaluation pairs and
- * reconstruction metrics (harness/calibration.h): the measurements
+ * reconstruction metrics (costs/calibration.h): the measurements
  * `tcbench calibrate` makes, the steps' also bench_train_step's. */
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
 
-#include "harness/calibration.h"
-#include "harness/internal.h"
+#include "costs/calibration.h"
+#include "costs/step_timing.h"
+#include "scoring/scoring.h"
 #include "tcb/metrics.h"
 #include "tcb/synth.h"
 

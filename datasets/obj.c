@@ -4,7 +4,7 @@
  * C string in place (its '\n' and any '#' comment become NUL), so strtof and
  * strtol can never run into the next line. Only positions and triangles are
  * kept; texture and normal indices are checked for syntax and dropped. */
-#include "tcb/mesh.h"
+#include "tcb/mesh_io.h"
 
 #include <limits.h>
 #include <math.h>
@@ -251,11 +251,4 @@ int tcb_obj_write(const char *path, const float *verts, int nv, const int32_t *f
         fprintf(af.fp, "f %d %d %d\n", f[0] + 1, f[1] + 1, f[2] + 1);
     }
     return tcb_atomic_commit(&af, err);
-}
-
-void tcb_mesh_free(tcb_mesh *m)
-{
-    free(m->verts);
-    free(m->faces);
-    memset(m, 0, sizeof *m);
 }

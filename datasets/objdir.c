@@ -12,7 +12,7 @@
 #include "datasets/cache.h"
 #include "datasets/strbuf.h"
 #include "tcb/fsutil.h"
-#include "tcb/mesh.h"
+#include "tcb/mesh_io.h"
 
 /* The last run of digits in name[0..len): "mesh.01" → 1, "mesh_0001" → 1,
  * "take2_frame10" → 10. Returns 0 when there is none or it overflows. */

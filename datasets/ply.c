@@ -5,7 +5,7 @@
 #include <stdio.h>
 
 #include "tcb/fsutil.h"
-#include "tcb/mesh.h"
+#include "tcb/mesh_io.h"
 
 int tcb_ply_write(const char *path, const float *verts, int nv, const int32_t *faces, int nf,
                   const uint8_t *rgb, tcb_error *err)

@@ -7,10 +7,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/internal.h"
-#include "harness/results_format.h"
+#include "scoring/scoring.h"
+#include "store/cell_format.h"
+#include "tcb/config.h"
+#include "tcb/npy.h"
+#include "tcb/predictions.h"
+#include "tcb/runner.h"
 #include "tcb/score.h"
-#include "tcb/tcb.h"
+#include "tcb/sysinfo.h"
+#include "tcb/version.h"
 
 /* The dtype names promise these sizes to the binding. */
 _Static_assert(sizeof(float) == 4 && sizeof(double) == 8, "float32 and float64");

@@ -10,10 +10,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/internal.h"
+#include "harness/harness_internal.h"
+#include "scoring/scoring.h"
 #include "tcb/fsutil.h"
 #include "tcb/geometry.h"
 #include "tcb/metrics.h"
+#include "tcb/sysinfo.h"
 
 /* Per-pair scratch, sized for the sequence once per cell, and the scorer
  * (the edge graph of the faces, for the geodesic error), also made once. */
@@ -47,12 +49,6 @@ static int eval_bufs_init(const tcb_sequence *seq, eval_bufs *b, tcb_error *herr
     int rc = tcb_pair_scorer_init(&b->scorer, seq, herr);
     if (rc) eval_bufs_free(b);
     return rc;
-}
-
-void tcb_cell_label(char *out, size_t size, const char *dataset, const char *sequence,
-                    const char *method, int seed)
-{
-    snprintf(out, size, "%s/%s/%s/seed %d", dataset, sequence, method, seed);
 }
 
 int tcb_cell_identity(const tcb_cell_job *job, tcb_cell_result *c, tcb_error *herr)

@@ -21,7 +21,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "harness/internal.h"
+#include "harness/harness_internal.h"
 #include "tcb/fsutil.h"
 #include "tcb/json.h"
 

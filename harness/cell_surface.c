@@ -9,7 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/internal.h"
+#include "harness/harness_internal.h"
+#include "scoring/scoring.h"
 
 /* Scratch for one frame: the two sample sets and their normals. */
 typedef struct samples {

@@ -2,13 +2,25 @@
  * methods that run on the dataset, their seeds — numbered from 0. An id
  * depends only on the config, never on what has run, so `--cell 7` and
  * `--shard 2/8` name the same work on every machine and after every
- * restart. */
+ * restart. Also which cells a run selects (--only) and how the engine
+ * names a cell in progress lines, logs and model records. */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/internal.h"
+#include "harness/harness_internal.h"
+
+int tcb_run_selected(const tcb_run_opts *opts, const tcb_method_spec *m)
+{
+    return !opts->only_method || strcmp(opts->only_method, m->label) == 0;
+}
+
+void tcb_cell_label(char *out, size_t size, const char *dataset, const char *sequence,
+                    const char *method, int seed)
+{
+    snprintf(out, size, "%s/%s/%s/seed %d", dataset, sequence, method, seed);
+}
 
 int tcb_grid_cells_per_sequence(const tcb_config *cfg, const tcb_dataset_spec *d)
 {

@@ -20,7 +20,7 @@
 
 #include <cjson/cJSON.h>
 
-#include "harness/internal.h"
+#include "harness/harness_internal.h"
 #include "tcb/fsutil.h"
 #include "tcb/hash.h"
 #include "tcb/json.h"

@@ -7,13 +7,13 @@
  * method estimates its own cost (tcb_method_ops.estimate), a trained one
  * by naming the preset whose costs `tcbench calibrate` measured, and the
  * harness prices it and adds its scoring of the pairs from the
- * calibrations (harness/calibration.h). */
+ * calibrations (costs/calibration.h). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/calibration.h"
-#include "harness/internal.h"
+#include "costs/calibration.h"
+#include "harness/harness_internal.h"
 #include "tcb/dfaust.h"
 #include "tcb/registry.h"
 #include "tcb/synth.h"

@@ -27,7 +27,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
-#include "harness/internal.h"
+#include "harness/harness_internal.h"
 #include "tcb/fsutil.h"
 #include "tcb/json.h"
 

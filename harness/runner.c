@@ -11,11 +11,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/internal.h"
+#include "harness/harness_internal.h"
 #include "tcb/dfaust.h"
 #include "tcb/fsutil.h"
 #include "tcb/registry.h"
 #include "tcb/synth.h"
+#include "tcb/sysinfo.h"
 
 /* What the grid loop carries from one sequence to the next. */
 typedef struct run_state {
@@ -56,11 +57,6 @@ static const tcb_method_spec *find_label(const tcb_config *cfg, const char *labe
     for (int k = 0; k < cfg->n_methods; k++)
         if (strcmp(cfg->methods[k].label, label) == 0) return &cfg->methods[k];
     return NULL;
-}
-
-int tcb_run_selected(const tcb_run_opts *opts, const tcb_method_spec *m)
-{
-    return !opts->only_method || strcmp(opts->only_method, m->label) == 0;
 }
 
 double tcb_run_lock_timeout(const tcb_run_opts *opts)

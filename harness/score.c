@@ -18,9 +18,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/internal.h"
+#include "harness/harness_internal.h"
+#include "scoring/scoring.h"
 #include "tcb/fsutil.h"
 #include "tcb/progress.h"
+#include "tcb/sysinfo.h"
 
 /* What a scored cell names as its method: not a registered method, only
  * the identity the cell file records (method_impl). */

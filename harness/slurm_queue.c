@@ -15,7 +15,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "harness/internal.h"
+#include "harness/harness_internal.h"
 
 #define SQUEUE_CMD "squeue --me --noheader --array --format='%F|%K|%T|%k' 2>&1"
 

@@ -25,7 +25,7 @@
 #include <stdlib.h>
 
 #include "tcb/nn.h"
-#include "tcb/score.h"
+#include "tcb/predictions.h"
 
 static int by_value(const void *a, const void *b)
 {

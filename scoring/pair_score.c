@@ -1,11 +1,11 @@
 /* The one path from a pair's prediction to a cell's numbers
- * (harness/internal.h): the projection onto frame j's GT vertices, the
+ * (harness/harness_internal.h): the projection onto frame j's GT vertices, the
  * paper's metrics, the geodesic error, the pair's record and the summary.
  * A method's cells (harness/cell.c) and scored cells (harness/score.c)
  * both come through here. */
 #include <string.h>
 
-#include "harness/internal.h"
+#include "scoring/scoring.h"
 
 int tcb_pair_scorer_init(tcb_pair_scorer *s, const tcb_sequence *seq, tcb_error *err)
 {

@@ -9,12 +9,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/internal.h"
 #include "tcb/fsutil.h"
-#include "tcb/score.h"
 #include "tcb/nn.h"
 #include "tcb/npy.h"
 #include "tcb/npz.h"
+#include "tcb/predictions.h"
 
 /* k when name is "<k>.npy" written as the format names files and members
  * (no sign, no leading zero; LONG_MAX past nine digits), else -1. */
@@ -25,7 +24,10 @@ static long pair_file_index(const char *name)
     return n > 9 ? LONG_MAX : strtol(name, NULL, 10);
 }
 
-int tcb_score_check_dir(const char *dir, int n_pairs, const char *split_path, tcb_error *err)
+/* The prediction directory: dir holds 0.npy … <n_pairs-1>.npy and no
+ * <k>.npy beyond (the split's path is for the messages). Errors name the
+ * file. */
+static int check_dir(const char *dir, int n_pairs, const char *split_path, tcb_error *err)
 {
     char path[TCB_PATH_MAX];
     if (!tcb_is_dir(dir)) return tcb_fail(err, TCB_ERR_IO, "%s: no such directory", dir);
@@ -208,7 +210,7 @@ int tcb_predictions_open(const char *path, int n_pairs, const char *split_path, 
     *p = (tcb_predictions){dir ? dir_read : npz_read, NULL, dir ? "pred_dir" : "pred_file", path, "scored from files"};
     if (!dir) return open_npz(path, n_pairs, split_path, p, err);
     p->ctx = (void *)path;
-    return tcb_score_check_dir(path, n_pairs, split_path, err);
+    return check_dir(path, n_pairs, split_path, err);
 }
 
 void tcb_predictions_close(tcb_predictions *p)

@@ -1,7 +1,7 @@
 /* What tcb/method.h promises of a method's surface of one frame, checked
  * before `tcbench frames` draws it or the reconstruction metrics sample
  * it. A mesh without charts (n_charts 0) has neither uv nor chart. */
-#include "harness/internal.h"
+#include "scoring/scoring.h"
 #include "tcb/geometry.h"
 
 static int faces_valid(const tcb_uv_mesh *m)

@@ -1,12 +1,14 @@
-/* Private to harness/: the vocabulary of the "tcbench-cell/1" file, shared
- * by its writer (results.c) and its reader (results_load.c).
+/* The vocabulary of the "tcbench-cell/1" file, shared by its writer
+ * (store/cell_write.c) and its reader (store/cell_read.c), and the cell as
+ * JSON for the bindings (harness/binding.c): the store's face beside
+ * tcb/results.h.
  *
  * Metric values may legitimately be non-finite in a diverged cell; JSON has
  * no NaN, so every float metric is written as null when not finite and
  * reads back as NAN (the Chamfer distance of a method without
  * reconstruction is the common case). Strings, counts and seeds are strict. */
-#ifndef TCB_HARNESS_RESULTS_FORMAT_H
-#define TCB_HARNESS_RESULTS_FORMAT_H
+#ifndef TCB_STORE_CELL_FORMAT_H
+#define TCB_STORE_CELL_FORMAT_H
 
 #include <cjson/cJSON.h>
 

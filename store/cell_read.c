@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/results_format.h"
+#include "store/cell_format.h"
 #include "tcb/json.h"
 
 static const char *const TOP_KEYS[] = {

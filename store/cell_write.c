@@ -6,10 +6,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/results_format.h"
+#include "store/cell_format.h"
 #include "tcb/fsutil.h"
 #include "tcb/json.h"
-#include "tcb/tcb.h"
+#include "tcb/version.h"
 
 const char *const tcb_cell_status_names[] = {"ok", "failed", "diverged", NULL};
 const char *const tcb_cell_role_names[] = {"train", "validation", "test", NULL};

@@ -6,9 +6,9 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "harness/internal.h"
 #include "tcb/fsutil.h"
 #include "tcb/registry.h"
+#include "views/cell_target.h"
 
 int tcb_run_config_open(const char *run_dir, tcb_config *cfg, tcb_error *err)
 {

@@ -1,10 +1,10 @@
 /* The checkerboard texture; see checker.h. */
-#include "harness/checker.h"
+#include "views/checker.h"
 
 #include <math.h>
 #include <stddef.h>
 
-#include "harness/render.h"
+#include "views/render.h"
 
 enum { INNER = TCB_CHECKER_CELL - 2 * TCB_CHECKER_GUTTER };
 

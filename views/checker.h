@@ -1,5 +1,5 @@
 /* The checkerboard texture of `tcbench frames` (tcb/frames.h). Private to
- * harness/.
+ * views/.
  *
  * One image serves every chart of a tcb_uv_mesh and every frame: chart c's
  * unit square sits in cell c of a grid (cols x rows, row 0 at the top),
@@ -9,8 +9,8 @@
  * hue (hues spread by the golden ratio, so charts with neighbouring numbers
  * differ most), the check at the chart's (u, v) origin white so a mirrored
  * or turned chart shows it. */
-#ifndef TCB_HARNESS_CHECKER_H
-#define TCB_HARNESS_CHECKER_H
+#ifndef TCB_VIEWS_CHECKER_H
+#define TCB_VIEWS_CHECKER_H
 
 #include <stdint.h>
 

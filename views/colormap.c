@@ -1,4 +1,4 @@
-#include "harness/colormap.h"
+#include "views/colormap.h"
 
 #include <float.h>
 #include <stddef.h>

@@ -1,7 +1,7 @@
 /* Vertex colours for the meshes `tcbench inspect` writes. Private to
- * harness/. */
-#ifndef TCB_HARNESS_COLORMAP_H
-#define TCB_HARNESS_COLORMAP_H
+ * views/. */
+#ifndef TCB_VIEWS_COLORMAP_H
+#define TCB_VIEWS_COLORMAP_H
 
 #include <stdint.h>
 

@@ -9,8 +9,9 @@
 #include <math.h>
 #include <string.h>
 
-#include "harness/frames_style.h"
 #include "tcb/fsutil.h"
+#include "views/cell_target.h"
+#include "views/frames_style.h"
 
 void tcb_frames_rng(const tcb_cell_job *cell, int i, int j, tcb_rng *rng)
 {

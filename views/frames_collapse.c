@@ -1,10 +1,10 @@
-/* Collapsed patches of a drawn surface (harness/frames_style.h): an atlas
+/* Collapsed patches of a drawn surface (views/frames_style.h): an atlas
  * whose training shrank a patch to a sliver or a point draws it as one,
  * which a reader of the strip cannot tell from a small patch; this says it. */
 #include <stdlib.h>
 
-#include "harness/frames_style.h"
 #include "tcb/geometry.h"
+#include "views/frames_style.h"
 
 int tcb_frames_collapsed(const tcb_uv_mesh *m, double gt_area, unsigned char *collapsed, int *n, tcb_error *err)
 {

@@ -1,10 +1,10 @@
 /* The two styles of `tcbench frames` (tcb/frames.h), each in its own file;
- * harness/frames.c picks the cell, the frames and the style. Private to
- * harness/. */
-#ifndef TCB_HARNESS_FRAMES_STYLE_H
-#define TCB_HARNESS_FRAMES_STYLE_H
+ * views/frames.c picks the cell, the frames and the style. Private to
+ * views/. */
+#ifndef TCB_VIEWS_FRAMES_STYLE_H
+#define TCB_VIEWS_FRAMES_STYLE_H
 
-#include "harness/internal.h"
+#include "harness/harness.h"
 #include "tcb/frames.h"
 #include "tcb/rng.h"
 
@@ -15,9 +15,9 @@ typedef struct tcb_frames_job {
     const char *dir;           /* created only once everything is computed */
 } tcb_frames_job;
 
-/* checker.png, checker.mtl, frame_<f>.obj, strip.png (harness/frames_texture.c). */
+/* checker.png, checker.mtl, frame_<f>.obj, strip.png (views/frames_texture.c). */
 int tcb_frames_texture(const tcb_frames_job *f, tcb_error *err);
-/* frame_<f>.ply, strip.png (harness/frames_transfer.c). */
+/* frame_<f>.ply, strip.png (views/frames_transfer.c). */
 int tcb_frames_transfer(const tcb_frames_job *f, tcb_error *err);
 
 /* A patch of a surface is collapsed when its area is under this fraction
@@ -29,11 +29,11 @@ int tcb_frames_transfer(const tcb_frames_job *f, tcb_error *err);
 
 /* Marks collapsed[c] for each collapsed chart c of m (the surface of a
  * frame of GT area gt_area), their count in *n (0 for a mesh without
- * charts). (harness/frames_collapse.c) */
+ * charts). (views/frames_collapse.c) */
 int tcb_frames_collapsed(const tcb_uv_mesh *m, double gt_area, unsigned char *collapsed, int *n, tcb_error *err);
 
 /* The cell seed's stream "frames/<dataset>/<sequence>/<i>" (j < 0: the
- * surface of frame i) or ".../<i>/<j>" (transfer i -> j). (harness/frames.c) */
+ * surface of frame i) or ".../<i>/<j>" (transfer i -> j). (views/frames.c) */
 void tcb_frames_rng(const tcb_cell_job *cell, int i, int j, tcb_rng *rng);
 
 #endif

@@ -6,13 +6,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/checker.h"
-#include "harness/colormap.h"
-#include "harness/frames_style.h"
-#include "harness/render.h"
 #include "tcb/fsutil.h"
 #include "tcb/geometry.h"
-#include "tcb/mesh.h"
+#include "tcb/mesh_io.h"
+#include "scoring/scoring.h"
+#include "views/checker.h"
+#include "views/colormap.h"
+#include "views/frames_style.h"
+#include "views/render.h"
 
 /* More charts would make the texture larger than viewers like (16 x 16
  * cells of 256 pixels: 4096 pixels a side). */

@@ -5,12 +5,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/colormap.h"
-#include "harness/frames_style.h"
-#include "harness/render.h"
 #include "tcb/fsutil.h"
 #include "tcb/geometry.h"
-#include "tcb/mesh.h"
+#include "tcb/mesh_io.h"
+#include "views/colormap.h"
+#include "views/frames_style.h"
+#include "views/render.h"
 
 typedef struct transfers {
     const tcb_frames_job *f;

@@ -7,13 +7,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/colormap.h"
-#include "harness/internal.h"
-#include "harness/render.h"
 #include "tcb/fsutil.h"
 #include "tcb/json.h"
-#include "tcb/mesh.h"
+#include "tcb/mesh_io.h"
 #include "tcb/registry.h"
+#include "tcb/results.h"
+#include "views/cell_target.h"
+#include "views/colormap.h"
+#include "views/render.h"
 
 typedef tcb_cell_target target;
 

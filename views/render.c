@@ -1,6 +1,6 @@
 /* Flat-shaded meshes by the painter's algorithm: enough for a few thousand
  * faces of one body, with no OpenGL context on a headless machine. */
-#include "harness/render.h"
+#include "views/render.h"
 
 #include <cairo.h>
 #include <float.h>
@@ -9,8 +9,8 @@
 #include <stdlib.h>
 #include <unistd.h>
 
-#include "harness/colormap.h"
 #include "tcb/fsutil.h"
+#include "views/colormap.h"
 
 enum { PANEL = 360, TITLE = 34, BAR = 46 };
 static const char *const FONT = "DejaVu Sans";

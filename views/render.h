@@ -1,7 +1,7 @@
 /* A row of flat-shaded mesh views in one PNG (cairo), for `tcbench
- * inspect` and `tcbench frames`. Private to harness/. */
-#ifndef TCB_HARNESS_RENDER_H
-#define TCB_HARNESS_RENDER_H
+ * inspect` and `tcbench frames`. Private to views/. */
+#ifndef TCB_VIEWS_RENDER_H
+#define TCB_VIEWS_RENDER_H
 
 #include <cairo.h>
 #include <stdint.h>

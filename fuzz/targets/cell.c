@@ -1,4 +1,4 @@
-/* The cell result reader (harness/results_load.c): what reports, checks
+/* The cell result reader (store/cell_read.c): what reports, checks
  * and resumption read from a run directory, possibly written elsewhere. */
 #include "fuzz/fuzz_util.h"
 #include "tcb/results.h"

@@ -1,4 +1,4 @@
-/* The config reader (harness/config.c, with the methods' and datasets'
+/* The config reader (config/config.c, with the methods' and datasets'
  * keys it validates): any text as a config. A config accepted is saved
  * beside the results as its normalized JSON, which must read back to
  * itself: the run directory's config.json is what resuming compares. */

@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "fuzz/fuzz_util.h"
-#include "harness/internal.h"
+#include "harness/harness_internal.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {

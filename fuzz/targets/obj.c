@@ -3,7 +3,7 @@
 #include <math.h>
 
 #include "fuzz/fuzz_util.h"
-#include "tcb/mesh.h"
+#include "tcb/mesh_io.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {

@@ -1,4 +1,4 @@
-/* The prediction files of `tcbench score` (harness/score_files.c): a .npy
+/* The prediction files of `tcbench score` (scoring/prediction_files.c): a .npy
  * of vertex ids or moved points, read for frames of 4 and of 5 vertices
  * (the seeds' sizes); what is accepted is in range and finite. */
 #include <math.h>

@@ -1,7 +1,7 @@
 /* tcbench — run configuration (JSON, validated; errors name the key).
  *
  * Paths to code resolve against the config file's directory (made
- * absolute when the config is read, harness/config_paths.c): "plugins",
+ * absolute when the config is read, config/config_paths.c): "plugins",
  * and an external method's "command" elements that name a file beside the
  * config. Paths to data and results — "output", "splits_dir", "cache_dir",
  * a dataset's "root" — stay relative to the current directory (the
@@ -173,6 +173,17 @@ void tcb_config_free(tcb_config *c);
  * which). */
 int tcb_config_find_sequence(const tcb_config *c, const char *dataset, const char *sequence,
                              const tcb_dataset_spec **d, const tcb_sequence_spec **s, tcb_error *err);
+
+/* Value names of the config's enums, NULL-terminated; indexed by the enum. */
+extern const char *const tcb_config_source_names[];   /* tcb_source */
+extern const char *const tcb_config_norm_names[];     /* tcb_normalization */
+extern const char *const tcb_config_protocol_names[]; /* by TCB_PROTOCOL_* bit position */
+extern const char *const tcb_config_sampling_names[]; /* with_replacement: 0, 1 */
+
+/* The config with every default filled in, pretty-printed (what a run
+ * directory records of it); malloc'ed, NULL
+ * when out of memory. (config/config_dump.c) */
+char *tcb_config_normalized_json(const tcb_config *c);
 
 #ifdef __cplusplus
 }

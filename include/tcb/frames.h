@@ -11,7 +11,7 @@
  *   checker.mtl     one material, map_Kd checker.png
  *   checker.png     the texture: chart c's square in cell c of a grid,
  *                   8 x 8 checks in two tones of the chart's hue, the check
- *                   at the chart's (0, 0) white (harness/checker.h)
+ *                   at the chart's (0, 0) white (views/checker.h)
  *   strip.png       the frames side by side, one camera, each face in the
  *                   texture's colour at its UV centroid; a frame whose
  *                   patches collapsed (area under 5 % of their share of

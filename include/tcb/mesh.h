@@ -1,17 +1,13 @@
-/* tcbench — one triangle mesh, the Wavefront OBJ reader/writer and a PLY
- * writer for coloured meshes.
- *
- * The reader accepts `v x y z`, `f` with `v`, `v/vt`, `v//vn`, `v/vt/vn`
- * forms, negative (relative) indices, polygons (fan-triangulated) and
- * comments; it ignores vt/vn/o/g/s/usemtl/mtllib lines. It rejects bad
- * numbers, NaN/Inf, zero or out-of-range indices, faces with < 3 vertices
- * and files without faces, naming file and line. */
+/* tcbench — one triangle mesh: the type every room passes meshes in, and
+ * its destructor, here with the type so that a room that only passes
+ * meshes (meshing/) needs no file reader. Reading and writing files:
+ * tcb/mesh_io.h. */
 #ifndef TCB_MESH_H
 #define TCB_MESH_H
 
 #include <stdint.h>
-
-#include "tcb/error.h"
+#include <stdlib.h>
+#include <string.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -24,16 +20,12 @@ typedef struct tcb_mesh {
     int32_t *faces;  /* [n_faces][3], 0-based */
 } tcb_mesh;
 
-int tcb_obj_read(const char *path, tcb_mesh *out, tcb_error *err);
-/* Written atomically. */
-int tcb_obj_write(const char *path, const float *verts, int nv, const int32_t *faces,
-                  int nf, tcb_error *err);
-/* A mesh (nf > 0) or point cloud (nf = 0, faces NULL) as ASCII PLY with
- * optional per-vertex colours rgb [nv][3] (NULL: none); written atomically.
- * (datasets/ply.c) */
-int tcb_ply_write(const char *path, const float *verts, int nv, const int32_t *faces, int nf,
-                  const uint8_t *rgb, tcb_error *err);
-void tcb_mesh_free(tcb_mesh *m);
+static inline void tcb_mesh_free(tcb_mesh *m)
+{
+    free(m->verts);
+    free(m->faces);
+    memset(m, 0, sizeof *m);
+}
 
 #ifdef __cplusplus
 }

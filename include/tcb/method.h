@@ -246,6 +246,12 @@ typedef struct tcb_method_ops {
     int (*run_unit)(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, int unit, tcb_error *err);
 } tcb_method_ops;
 
+/* The method of ops gives a surface per frame (tcb_method_ops.surface). */
+static inline int tcb_method_has_surface(const tcb_method_ops *ops)
+{
+    return ops->abi_version >= 3 && ops->surface;
+}
+
 typedef const tcb_method_ops *const *(*tcb_plugin_entry_fn)(int *count);
 #define TCB_PLUGIN_ENTRY "tcb_plugin_methods"
 

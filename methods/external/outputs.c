@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "methods/external/external.h"
-#include "tcb/score.h"
+#include "tcb/predictions.h"
 
 /* <work>/pred/<k>.npy, or recon_<k>_<which>.npy when which is 'i' or 'j'. */
 static int output_path(const ext_method *m, int k, char which, char *out, tcb_error *err)

@@ -42,7 +42,7 @@ nearest_dir=$(sed -n 's/^files: \(.*\)\/$/\1/p' nearest.log)
 /usr/bin/python3 - atlas "$nearest_dir" <<'PY'
 import struct, sys, zlib
 atlas, nearest = sys.argv[1:3]
-CELL, PANEL, HEIGHT = 256, 360, 34 + 360 + 46  # harness/checker.h, harness/render.c
+CELL, PANEL, HEIGHT = 256, 360, 34 + 360 + 46  # views/checker.h, views/render.c
 
 def png(path):
     """(width, height, rows of RGB(A) bytes) of an 8-bit PNG as cairo writes it."""

@@ -14,11 +14,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/internal.h"
-#include "harness/results_format.h"
+#include "scoring/scoring.h"
+#include "store/cell_format.h"
 #include "testutil.h"
 #include "tcb/binding.h"
 #include "tcb/json.h"
+#include "tcb/runner.h"
 #include "tcb/rng.h"
 #include "tcb/synth.h"
 

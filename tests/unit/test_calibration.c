@@ -1,4 +1,4 @@
-/* Calibrations (harness/calibration.h): a cost at any thread count from
+/* Calibrations (costs/calibration.h): a cost at any thread count from
  * the counts measured (exact, interpolated as a power law, extrapolated
  * with the last two's scaling clamped to [linear, flat]), the first
  * calibration that measured a method wins, a cell priced from them (steps,
@@ -15,7 +15,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "harness/calibration.h"
+#include "costs/calibration.h"
 #include "testutil.h"
 
 /* unit: kind unit's name; size: kind surface_frame's samples. */

@@ -1,4 +1,4 @@
-/* The checkerboard texture of `tcbench frames` (harness/checker.c): the
+/* The checkerboard texture of `tcbench frames` (views/checker.c): the
  * layout of charts in the image, texture coordinates inside their chart's
  * cell, the two tones and the white origin check, and the PNG holding what
  * tcb_checker_color says, read back with cairo. */
@@ -14,7 +14,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "harness/checker.h"
+#include "views/checker.h"
 #include "testutil.h"
 
 static void test_layout(void **state)

@@ -1,4 +1,4 @@
-/* What the command line changes in a config (harness/config_overlay.c): the
+/* What the command line changes in a config (config/config_overlay.c): the
  * variant (seeds, params merged by label or method name, the output
  * directory), the dataset roots from --root and the environment, and the
  * per-method "datasets" and the "reference" keys. */

@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "tcb/fsutil.h"
-#include "tcb/mesh.h"
+#include "tcb/mesh_io.h"
 #include "testutil.h"
 
 static int read_text(const char *dir, const char *text, tcb_mesh *m, tcb_error *err, char *path)

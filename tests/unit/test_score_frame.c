@@ -1,4 +1,4 @@
-/* The wrong-frame rule (tcb/score.h, harness/score_frame.c): points in the
+/* The wrong-frame rule (tcb/score.h, scoring/frame_rule.c): points in the
  * split's frame pass, however wrong; the same points in raw coordinates
  * are refused; each side of both thresholds (the ratio fit / fit_raw and
  * the floor on fit) is where the rule says; a normalisation that is the

@@ -1,8 +1,8 @@
-/* What tcb_surface_check (harness/surface_check.c) accepts of a method's
+/* What tcb_surface_check (scoring/surface_check.c) accepts of a method's
  * surface: a mesh parametrised by charts (uv and chart both given) or one
  * without (n_charts 0, both NULL; neupig's template), never half of a
  * parametrisation; and that a mesh without charts has no collapsed patches
- * (harness/frames_collapse.c). */
+ * (views/frames_collapse.c). */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -11,8 +11,8 @@
 
 #include <math.h>
 
-#include "harness/frames_style.h"
-#include "harness/internal.h"
+#include "views/frames_style.h"
+#include "scoring/scoring.h"
 
 /* A tetrahedron, its four vertices in one chart at the corners of (u, v). */
 static float verts[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
