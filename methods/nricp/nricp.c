@@ -20,7 +20,6 @@
 #include <stdio.h>
 
 #include "methods/params.h"
-#include "tcb/geometry.h"
 #include "tcb/json.h"
 
 #define WHERE "nricp.params"
@@ -50,26 +49,6 @@ static int nricp_create(const char *params_json, void **self, tcb_error *err)
     m->params = p;
     m->params.rounds = (int)rounds, m->params.smooth = (int)smooth, m->params.smooth_last = (int)smooth_last;
     *self = m;
-    return TCB_OK;
-}
-
-int nricp_prepare(nricp_method *m, const tcb_sequence *seq, tcb_error *err)
-{
-    if (seq->n_frames < 2 || seq->n_verts < 1)
-        return tcb_fail(err, TCB_ERR_INPUT,
-                        "nricp: sequence %s has %d frames of %d vertices (need at least 2 frames)", seq->name,
-                        seq->n_frames, seq->n_verts);
-    m->n_frames = seq->n_frames, m->n_verts = seq->n_verts;
-    nricp_chains_free(&m->chains); /* announced for the model this replaces */
-    nricp_ahead_free(&m->ahead);
-    m->seq_hash = nricp_sequence_hash(seq);
-    size_t frame = (size_t)seq->n_verts * 3;
-    free(m->normals);
-    m->normals = malloc((size_t)seq->n_frames * frame * sizeof *m->normals);
-    if (!m->normals) return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory for normals");
-    for (int f = 0; f < seq->n_frames; f++)
-        tcb_vertex_normals(tcb_seq_frame(seq, f), seq->n_verts, seq->faces, seq->n_faces,
-                           m->normals + f * frame);
     return TCB_OK;
 }
 

@@ -1,5 +1,6 @@
-/* The nricp method's state, shared by its table (nricp.c), the consecutive
- * maps (maps.c) and the checkpoint (checkpoint.c). */
+/* The nricp method's state, shared by its table (nricp.c), its setup
+ * (prepare.c), the consecutive maps (maps.c), the checkpoint
+ * (checkpoint.c) and the deform chains and random batches. */
 #ifndef TCB_NRICP_INTERNAL_H
 #define TCB_NRICP_INTERNAL_H
 
@@ -84,7 +85,9 @@ static inline size_t nricp_map_at(const nricp_method *m, int a, int b)
     return nricp_map_row(m, a, b) * (size_t)m->n_verts;
 }
 
-/* Sizes and vertex normals of seq (fit and load both start here). */
+/* prepare.c: sizes, sequence hash and vertex normals of seq (fit and
+ * load both start here); drops the chains and batches of the model it
+ * replaces. */
 int nricp_prepare(nricp_method *m, const tcb_sequence *seq, tcb_error *err);
 
 /* maps.c: compute every consecutive map (OpenMP over the 2(F−1)
