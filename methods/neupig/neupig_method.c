@@ -31,19 +31,17 @@
  * fit's seed, and load rebuilds the template from the sequence with that
  * seed (the clouds, keyframe, normals and Poisson surface are
  * deterministic) rather than storing it. */
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "methods/builtin.h"
 #include "methods/neupig/prepare.h"
+#include "methods/neupig/template.h"
 #include "methods/neupig/train.h"
 #include "methods/params.h"
 #include "methods/step_cost.h"
 #include "neural/train_loop.h"
 #include "neural/weights.h"
-#include "tcb/fsutil.h"
-#include "tcb/geodesic.h"
 #include "tcb/geometry.h"
 #include "tcb/json.h"
 #include "tcb/locate.h"
@@ -196,72 +194,6 @@ static int draw_clouds(neupig_method *m, const tcb_sequence *seq, uint64_t seed,
     return rc;
 }
 
-/* Normals of the keyframe's cloud: estimated, or the GT face under each
- * point (the cloud comes from the GT surface; the map is a similarity, so
- * face normals are the same in the cube). */
-static int keyframe_normals(const neupig_method *m, const tcb_sequence *seq, const inputs *in, float *normals,
-                            tcb_error *err)
-{
-    const float *cloud = in->clouds[in->key];
-    int n = in->n[in->key];
-    if (!m->gt_normals) return tcb_estimate_normals(cloud, n, TCB_NORMALS_K, normals, err);
-    float *gt = malloc((size_t)seq->n_verts * 3 * sizeof *gt);
-    tcb_surface_point *loc = malloc((size_t)n * sizeof *loc);
-    int rc = gt && loc ? TCB_OK : tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
-    if (!rc) {
-        tcb_neupig_map_points(&m->map, tcb_seq_frame(seq, in->key), seq->n_verts, gt);
-        rc = tcb_mesh_locate(gt, seq->n_verts, seq->faces, seq->n_faces, cloud, n, loc, NULL, err);
-    }
-    for (int i = 0; !rc && i < n; i++) {
-        const int32_t *f = seq->faces + 3 * (size_t)loc[i].face;
-        const float *a = gt + 3 * (size_t)f[0], *b = gt + 3 * (size_t)f[1], *c = gt + 3 * (size_t)f[2];
-        double u[3], v[3], nn[3], len;
-        for (int k = 0; k < 3; k++) u[k] = (double)b[k] - a[k], v[k] = (double)c[k] - a[k];
-        nn[0] = u[1] * v[2] - u[2] * v[1], nn[1] = u[2] * v[0] - u[0] * v[2], nn[2] = u[0] * v[1] - u[1] * v[0];
-        len = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
-        for (int k = 0; k < 3; k++) normals[3 * (size_t)i + k] = (float)(len > 0 ? nn[k] / len : 0.0);
-    }
-    free(gt), free(loc);
-    return rc;
-}
-
-/* The keyframe's screened Poisson surface, decimated to the budget. */
-static int build_template(neupig_method *m, const tcb_sequence *seq, const inputs *in, tcb_error *err)
-{
-    int n = in->n[in->key];
-    float *normals = malloc((size_t)n * 3 * sizeof *normals);
-    tcb_mesh surface = {0, 0, NULL, NULL};
-    int rc = normals ? keyframe_normals(m, seq, in, normals, err) : tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
-    if (!rc) rc = tcb_poisson_reconstruct(in->clouds[in->key], normals, n, m->poisson_depth, &surface, err);
-    if (!rc) rc = tcb_mesh_decimate(&surface, m->template_faces, &m->template_mesh, err);
-    tcb_mesh_free(&surface);
-    free(normals);
-    return rc;
-}
-
-/* The template's undirected edges (each once, a < b) and their lengths. */
-static int template_edges(const tcb_mesh *t, inputs *in, tcb_error *err)
-{
-    tcb_edge_graph g;
-    int rc = tcb_edge_graph_build(t->faces, t->n_faces, t->n_verts, &g, err);
-    if (rc) return rc;
-    in->edges = malloc(2 * (size_t)g.n_edges * sizeof *in->edges);
-    in->edge_len = malloc((size_t)g.n_edges * sizeof *in->edge_len);
-    if (!in->edges || !in->edge_len) rc = tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
-    for (int a = 0; !rc && a < g.n_verts; a++)
-        for (int e = g.offsets[a]; e < g.offsets[a + 1]; e++) {
-            int b = g.adj[e];
-            if (b < a) continue;
-            const float *p = t->verts + 3 * (size_t)a, *q = t->verts + 3 * (size_t)b;
-            double d = 0.0;
-            for (int k = 0; k < 3; k++) d += ((double)p[k] - q[k]) * ((double)p[k] - q[k]);
-            in->edges[2 * in->ne] = a, in->edges[2 * in->ne + 1] = b;
-            in->edge_len[in->ne++] = (float)sqrt(d);
-        }
-    tcb_edge_graph_free(&g);
-    return rc;
-}
-
 static int prepare(neupig_method *m, const tcb_sequence *seq, uint64_t seed, inputs *in, tcb_error *err)
 {
     memset(in, 0, sizeof *in);
@@ -269,14 +201,13 @@ static int prepare(neupig_method *m, const tcb_sequence *seq, uint64_t seed, inp
     int rc = draw_clouds(m, seq, seed, in, err);
     if (!rc)
         rc = tcb_neupig_keyframe((const float *const *)in->clouds, in->n, in->T, TCB_NEUPIG_KEYFRAME_RES, &in->key, err);
-    if (!rc) rc = build_template(m, seq, in, err);
+    const tcb_neupig_template_spec spec = {m->gt_normals, m->poisson_depth, m->template_faces};
+    if (!rc)
+        rc = tcb_neupig_template_build(seq, in->key, &m->map, in->clouds[in->key], in->n[in->key], &spec,
+                                       &m->template_mesh, err);
     const tcb_mesh *t = &m->template_mesh;
-    if (!rc && !(in->vnormals = malloc((size_t)t->n_verts * 3 * sizeof *in->vnormals)))
-        rc = tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
-    if (!rc) {
-        tcb_vertex_normals(t->verts, t->n_verts, t->faces, t->n_faces, in->vnormals);
-        rc = template_edges(t, in, err);
-    }
+    if (!rc) rc = tcb_neupig_template_normals(t, &in->vnormals, err);
+    if (!rc) rc = tcb_neupig_template_edges(t, &in->edges, &in->edge_len, &in->ne, err);
     if (!rc)
         in->problem = (tcb_neupig_problem){t->n_verts, t->verts, in->vnormals, in->ne, in->edges, in->edge_len,
                                            in->T, (const float *const *)in->clouds, in->n,
@@ -300,29 +231,6 @@ static int deform_all(neupig_method *m, const inputs *in, tcb_error *err)
 }
 
 /* ---- fit ---- */
-
-/* Points of the cube back in the sequence's coordinates, in place. */
-static void unmap(const neupig_method *m, float *pts, int n)
-{
-    for (size_t i = 0; i < 3 * (size_t)n; i++) pts[i] = (float)(pts[i] / m->map.scale + m->map.centre[i % 3]);
-}
-
-/* The template as fitting starts, in the sequence's coordinates, for people
- * to open and check against the keyframe's GT mesh (scripts/
- * neupig_template.py): <work_dir>/template_keyframe_<K>.obj. */
-static int write_template(const neupig_method *m, const char *work_dir, int keyframe, tcb_error *err)
-{
-    const tcb_mesh *t = &m->template_mesh;
-    char path[TCB_PATH_MAX];
-    float *verts = malloc((size_t)t->n_verts * 3 * sizeof *verts);
-    if (!verts) return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
-    memcpy(verts, t->verts, (size_t)t->n_verts * 3 * sizeof *verts);
-    unmap(m, verts, t->n_verts);
-    int rc = tcb_path_join(path, sizeof path, err, "%s/template_keyframe_%d.obj", work_dir, keyframe);
-    if (!rc) rc = tcb_obj_write(path, verts, t->n_verts, t->faces, t->n_faces, err);
-    free(verts);
-    return rc;
-}
 
 static int fit_step(void *t, double *loss, tcb_error *err) { return tcb_neupig_train_step(t, loss, err); }
 static long long fit_done(const void *t) { return ((const tcb_neupig_trainer *)t)->it; }
@@ -353,7 +261,7 @@ static int fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_
     inputs in;
     fit_state s = {.seed = ctx->seed};
     int rc = prepare(m, seq, ctx->seed, &in, err);
-    if (!rc) rc = write_template(m, ctx->work_dir, in.key, err);
+    if (!rc) rc = tcb_neupig_template_write(&m->template_mesh, &m->map, ctx->work_dir, in.key, err);
     if (!rc) rc = tcb_neupig_trainer_init(&s.trainer, &m->arch, &m->sched, &in.problem, ctx->seed, err);
     if (!rc) {
         tcb_train_loop loop = {.name = "neupig", .iterations = m->sched.epochs, .checkpoint_every = m->checkpoint_every,
@@ -405,7 +313,7 @@ static int transfer(void *self, const tcb_sequence *seq, int i, int j, const flo
     rc = tcb_mesh_locate(frame_of(m, i), t->n_verts, t->faces, t->n_faces, out, n, loc, NULL, err);
     if (!rc) {
         tcb_surface_points(frame_of(m, j), t->faces, loc, n, out);
-        unmap(m, out, n);
+        tcb_neupig_unmap_points(&m->map, out, n);
     }
     free(loc);
     return rc;
@@ -427,7 +335,7 @@ static int reconstruct(void *self, const tcb_sequence *seq, int i, int j, int fr
         free(*pts), *pts = NULL;
         return rc;
     }
-    unmap(m, *pts, m->recon_points);
+    tcb_neupig_unmap_points(&m->map, *pts, m->recon_points);
     *n = m->recon_points;
     return TCB_OK;
 }
@@ -451,7 +359,7 @@ static int surface(void *self, const tcb_sequence *seq, int frame, tcb_rng *rng,
         return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
     }
     memcpy(out->verts, frame_of(m, frame), vbytes);
-    unmap(m, out->verts, t->n_verts);
+    tcb_neupig_unmap_points(&m->map, out->verts, t->n_verts);
     memcpy(out->faces, t->faces, fbytes);
     out->n_verts = t->n_verts, out->n_faces = t->n_faces;
     return TCB_OK;

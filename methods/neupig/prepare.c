@@ -31,6 +31,11 @@ void tcb_neupig_map_points(const tcb_neupig_frame_map *m, const float *pts, int 
     for (size_t i = 0; i < 3 * (size_t)n; i++) out[i] = (float)((pts[i] - m->centre[i % 3]) * m->scale);
 }
 
+void tcb_neupig_unmap_points(const tcb_neupig_frame_map *m, float *pts, int n)
+{
+    for (size_t i = 0; i < 3 * (size_t)n; i++) pts[i] = (float)(pts[i] / m->scale + m->centre[i % 3]);
+}
+
 static int cmp_u64(const void *a, const void *b)
 {
     uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;

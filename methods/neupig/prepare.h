@@ -34,6 +34,10 @@ int tcb_neupig_frame_map_of(const float *const *points, const int *n, int T, tcb
 /* out [n][3] = the map applied to pts [n][3] (may alias). */
 void tcb_neupig_map_points(const tcb_neupig_frame_map *m, const float *pts, int n, float *out);
 
+/* Its inverse, in place: pts [n][3] of the cube back in the sequence's
+ * coordinates (the read-out's points and the template's OBJ). */
+void tcb_neupig_unmap_points(const tcb_neupig_frame_map *m, float *pts, int n);
+
 /* The keyframe of normalised points [T] → [n[t]][3] on a res³ lattice. */
 int tcb_neupig_keyframe(const float *const *points, const int *n, int T, int res, int *key, tcb_error *err);
 
