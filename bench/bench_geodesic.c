@@ -202,7 +202,7 @@ static void run_mesh(const frames *f, int reps)
 int main(int argc, char **argv)
 {
     const char *data = argc > 1 ? argv[1] : "../shared/data";
-    int reps = argc > 2 ? bench_positive_int(argv[2], "reps", "top of bench/geodesic.c") : 3;
+    int reps = argc > 2 ? bench_positive_int(argv[2], "reps", "top of bench/bench_geodesic.c") : 3;
     frames meshes[2];
     memset(meshes, 0, sizeof meshes);
     if (!read_crane(data, &meshes[0])) {

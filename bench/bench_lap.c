@@ -166,11 +166,11 @@ int main(int argc, char **argv)
     char script[4096];
     bench_sibling_path(script, sizeof script, __FILE__, "lap_scipy.py");
     for (int a = 1; a < argc; a++) {
-        if (strcmp(argv[a], "--reps") == 0 && a + 1 < argc) reps = bench_positive_int(argv[++a], "--reps", "top of bench/lap.c");
+        if (strcmp(argv[a], "--reps") == 0 && a + 1 < argc) reps = bench_positive_int(argv[++a], "--reps", "top of bench/bench_lap.c");
         else if (strcmp(argv[a], "--scipy") == 0 && a + 1 < argc)
             snprintf(script, sizeof script, "%s", argv[++a]);
         else if (atoi(argv[a]) > 0 && nsizes < 32) sizes[nsizes++] = atoi(argv[a]);
-        else die("bad argument %s (usage: top of bench/lap.c)", argv[a]);
+        else die("bad argument %s (usage: top of bench/bench_lap.c)", argv[a]);
     }
     if (nsizes == 0) sizes[0] = 1000, sizes[1] = 2500, sizes[2] = 5000, nsizes = 3;
     bench(sizes, nsizes, reps < 1 ? 1 : reps, script);

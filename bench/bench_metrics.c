@@ -32,7 +32,7 @@ static double time_pair(const float *v, int K, const int32_t *pred, int reps)
 
 int main(int argc, char **argv)
 {
-    int reps = argc > 1 ? bench_positive_int(argv[1], "reps", "top of bench/metrics.c") : 5;
+    int reps = argc > 1 ? bench_positive_int(argv[1], "reps", "top of bench/bench_metrics.c") : 5;
     static const int sizes[] = {1297, 6890, 10002};
     printf("one pair's metrics, best of %d, %d thread(s)\n", reps, omp_get_max_threads());
     printf("%8s %16s %16s\n", "K", "all wrong ms", "1/3 exact ms");

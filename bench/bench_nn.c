@@ -37,7 +37,7 @@ static double time_backend(tcb_nn_backend backend, const float *pts, const float
 
 int main(int argc, char **argv)
 {
-    int reps = argc > 1 ? bench_positive_int(argv[1], "reps", "top of bench/nn.c") : 5;
+    int reps = argc > 1 ? bench_positive_int(argv[1], "reps", "top of bench/bench_nn.c") : 5;
     static const int sizes[] = {1000, 2500, 5000, 10000, 20000};
     int nmax = sizes[sizeof sizes / sizeof *sizes - 1];
     float *pts = malloc((size_t)nmax * 3 * sizeof(float));

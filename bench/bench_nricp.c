@@ -125,7 +125,7 @@ static double run(const workload *w, int pairs, int threads)
 int main(int argc, char **argv)
 {
     const char *data = argc > 1 ? argv[1] : "../shared/data";
-    int pairs = argc > 2 ? bench_positive_int(argv[2], "pairs", "top of bench/nricp.c") : 24;
+    int pairs = argc > 2 ? bench_positive_int(argv[2], "pairs", "top of bench/bench_nricp.c") : 24;
     workload w[2];
     int nw = 0;
     w[nw++] = synthetic();
