@@ -19,7 +19,7 @@
 #include <string.h>
 
 #include "bench_util.h"
-#include "methods/nricp/nricp_internal.h"
+#include "methods/nricp/deform_cost.h"
 #include "tcb/progress.h"
 #include "tcb/registry.h"
 #include "tcb/split.h"

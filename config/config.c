@@ -10,9 +10,9 @@
 #include <string.h>
 
 #include "config/config_internal.h"
-#include "tcb/metrics.h"
 #include "tcb/align.h"
 #include "tcb/json.h"
+#include "tcb/metrics.h"
 #include "tcb/synth.h"
 
 #define WHERE_MAX 512

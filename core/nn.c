@@ -18,7 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Brute force below this many points, kd-tree at and above it. bench/nn.c
+/* Brute force below this many points, kd-tree at and above it. bench/bench_nn.c
  * (n points, n queries, build included; 2-core AMD EPYC dev machine) gives
  * brute/kd-tree time ratios of
  *     n        1k    2.5k    3k    3.5k   4k    5k    10k   20k

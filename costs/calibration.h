@@ -25,7 +25,6 @@
 #define TCB_COSTS_CALIBRATION_H
 
 #include "tcb/method.h"
-#include "tcb/sequence.h"
 
 typedef enum tcb_cost_kind {
     TCB_COST_STEP,

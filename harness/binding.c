@@ -14,7 +14,6 @@
 #include "tcb/predictions.h"
 #include "tcb/runner.h"
 #include "tcb/score.h"
-#include "tcb/sysinfo.h"
 #include "tcb/version.h"
 
 /* The dtype names promise these sizes to the binding. */

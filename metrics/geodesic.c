@@ -17,7 +17,7 @@
  * what the landmarks cost. The decision depends on the pair only, not on
  * timing or threads, so results are reproducible.
  *
- * Measured (bench/geodesic.c, crane, random predictions): the landmarks
+ * Measured (bench/bench_geodesic.c, crane, random predictions): the landmarks
  * make a bad method's pair several times cheaper; a good method's pair
  * never builds them. */
 #include <math.h>

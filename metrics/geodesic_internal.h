@@ -11,7 +11,7 @@
 
 /* Landmarks of the ALT heuristic (Goldberg & Harrelson, SODA 2005): 16
  * keeps a vertex's distances in two cache lines and, measured on the crane
- * with random predictions, most of the gain (bench/geodesic.c). */
+ * with random predictions, most of the gain (bench/bench_geodesic.c). */
 #define TCB_GEO_LANDMARKS 16
 
 typedef struct tcb_geo_heap_entry {

@@ -5,7 +5,6 @@
 #define TCB_VIEWS_FRAMES_STYLE_H
 
 #include "harness/harness.h"
-#include "tcb/frames.h"
 #include "tcb/rng.h"
 
 typedef struct tcb_frames_job {

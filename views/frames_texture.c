@@ -6,10 +6,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scoring/scoring.h"
+#include "tcb/frames.h"
 #include "tcb/fsutil.h"
 #include "tcb/geometry.h"
 #include "tcb/mesh_io.h"
-#include "scoring/scoring.h"
 #include "views/checker.h"
 #include "views/colormap.h"
 #include "views/frames_style.h"

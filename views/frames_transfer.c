@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "tcb/frames.h"
 #include "tcb/fsutil.h"
 #include "tcb/geometry.h"
 #include "tcb/mesh_io.h"

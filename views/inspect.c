@@ -10,7 +10,6 @@
 #include "tcb/fsutil.h"
 #include "tcb/json.h"
 #include "tcb/mesh_io.h"
-#include "tcb/registry.h"
 #include "tcb/results.h"
 #include "views/cell_target.h"
 #include "views/colormap.h"

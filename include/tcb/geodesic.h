@@ -43,7 +43,7 @@
  * are admissible, so every distance is Dijkstra's. Sources run in
  * parallel (OpenMP), each query independent, and every choice depends on
  * the pair alone: results do not depend on the thread count. Measured by
- * bench/geodesic.c (docs/protocol.md quotes it).
+ * bench/bench_geodesic.c (docs/protocol.md quotes it).
  *
  * Memory. The graph's topology serves every frame (they share the faces),
  * so the harness builds it once per cell: about 4(2·nv + 2·n_edges) bytes.

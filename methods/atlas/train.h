@@ -6,8 +6,8 @@
 
 #include <stdint.h>
 
-#include "neural/adam.h"
 #include "methods/atlas/model.h"
+#include "neural/adam.h"
 #include "tcb/error.h"
 #include "tcb/rng.h"
 #include "tcb/sequence.h"

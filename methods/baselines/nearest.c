@@ -5,8 +5,8 @@
  * j's vertices does the whole job, so transfer returns the points as given. */
 #include <string.h>
 
-#include "methods/builtin.h"
 #include "methods/baselines/stateless.h"
+#include "methods/builtin.h"
 
 static int nearest_create(const char *params_json, void **self, tcb_error *err)
 {

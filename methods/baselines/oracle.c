@@ -5,8 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "methods/builtin.h"
 #include "methods/baselines/stateless.h"
+#include "methods/builtin.h"
 
 static int oracle_create(const char *params_json, void **self, tcb_error *err)
 {

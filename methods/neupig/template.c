@@ -11,6 +11,7 @@
 #include "tcb/geodesic.h"
 #include "tcb/geometry.h"
 #include "tcb/locate.h"
+#include "tcb/mesh_io.h"
 #include "tcb/meshing.h"
 
 /* The unit normal of triangle (a, b, c), in double as the reference's

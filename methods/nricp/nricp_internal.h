@@ -6,6 +6,7 @@
 
 #include <stdint.h>
 
+#include "methods/nricp/deform_cost.h"
 #include "methods/nricp/register.h"
 #include "tcb/method.h"
 
@@ -111,9 +112,6 @@ int nricp_deform_pairs(nricp_method *m, const tcb_sequence *seq, const int *pair
 int nricp_deform_transfer(const nricp_method *m, const tcb_sequence *seq, int i, int j, const float *src,
                           float *out, tcb_error *err);
 void nricp_chains_free(nricp_chains *cs);
-/* Registrations the chains of n uniformly drawn pairs (j ≠ i) over F
- * frames take, in expectation. */
-double nricp_deform_expected_steps(int n_frames, int n_pairs);
 
 /* random_ahead.c: announce resets the batches to the n pairs (i, j) of
  * pairs[2p], pairs[2p + 1], to be registered over `threads`. take sets

@@ -42,8 +42,8 @@ expect 1 'views/inspect.c:2: includes harness/harness_internal.h: private to har
 fresh; plant bench/train_step.c '#include "config/config_internal.h"'
 expect 1 'bench/train_step.c:2: includes config/config_internal.h: private to config/' python3 "$check" tree
 
-fresh; plant metrics/metrics.c '#include "tcb/tcb.h"'
-expect 1 'metrics/metrics.c:2: includes tcb/tcb.h: library code names the headers it uses' python3 "$check" tree
+fresh; plant metrics/chamfer.c '#include "tcb/tcb.h"'
+expect 1 'metrics/chamfer.c:2: includes tcb/tcb.h: library code names the headers it uses' python3 "$check" tree
 
 fresh; plant include/tcb/sequence.h '#include "tcb/results.h"'
 expect 1 'include/tcb/sequence.h:2: includes tcb/results.h: datasets/ may not import store/' python3 "$check" tree
