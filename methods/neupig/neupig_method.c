@@ -45,7 +45,6 @@
 #include "tcb/geometry.h"
 #include "tcb/json.h"
 #include "tcb/locate.h"
-#include "tcb/mesh_io.h"
 #include "tcb/meshing.h"
 
 #define CKPT_NAME "train.ckpt"

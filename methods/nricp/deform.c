@@ -19,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "methods/nricp/deform_cost.h"
 #include "methods/nricp/nricp_internal.h"
 #include "tcb/fsutil.h"
 

@@ -12,13 +12,13 @@
  *
  * The clouds are the GT vertices of each frame with area-weighted vertex
  * normals (§6.1: normals are required and only meshes have them). */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "methods/builtin.h"
+#include "methods/nricp/deform_cost.h"
 #include "methods/nricp/nricp_internal.h"
-#include <stdio.h>
-
 #include "methods/params.h"
 #include "tcb/json.h"
 

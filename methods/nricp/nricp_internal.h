@@ -6,7 +6,6 @@
 
 #include <stdint.h>
 
-#include "methods/nricp/deform_cost.h"
 #include "methods/nricp/register.h"
 #include "tcb/method.h"
 

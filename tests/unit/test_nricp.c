@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "methods/nricp/deform_cost.h"
 #include "methods/nricp/knn_compat.h"
 #include "methods/nricp/nricp_internal.h"
 #include "methods/nricp/register.h"
