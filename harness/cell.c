@@ -15,15 +15,18 @@
 #include "tcb/fsutil.h"
 #include "tcb/geometry.h"
 #include "tcb/metrics.h"
+#include "tcb/registry.h"
 #include "tcb/sysinfo.h"
 
-/* Per-pair scratch, sized for the sequence once per cell, and the scorer
- * (the edge graph of the faces, for the geodesic error), also made once. */
+/* Per-pair scratch, sized for the sequence once per cell, the scorer (the
+ * edge graph of the faces, for the geodesic error) and the index of every
+ * frame's vertices a transfer is checked against, also made once. */
 typedef struct eval_bufs {
     float *moved;   /* [nv][3] transfer output on frame j */
     int32_t *pred;  /* [nv] predicted vertex ids of frame j */
     double *geo;    /* [nv] each vertex's normalised geodesic error */
     tcb_pair_scorer scorer;
+    tcb_nn *shape;  /* [n_frames * nv] for tcb_transfer_check */
 } eval_bufs;
 
 static void eval_bufs_free(eval_bufs *b)
@@ -32,6 +35,7 @@ static void eval_bufs_free(eval_bufs *b)
     free(b->pred);
     free(b->geo);
     tcb_pair_scorer_free(&b->scorer);
+    tcb_nn_free(b->shape);
     memset(b, 0, sizeof *b);
 }
 
@@ -47,6 +51,7 @@ static int eval_bufs_init(const tcb_sequence *seq, eval_bufs *b, tcb_error *herr
         return tcb_fail(herr, TCB_ERR_NOMEM, "out of memory for %zu vertices", nv);
     }
     int rc = tcb_pair_scorer_init(&b->scorer, seq, herr);
+    if (!rc) rc = tcb_nn_build(seq->verts, seq->n_verts * seq->n_frames, &b->shape, herr);
     if (rc) eval_bufs_free(b);
     return rc;
 }
@@ -58,6 +63,12 @@ int tcb_cell_identity(const tcb_cell_job *job, tcb_cell_result *c, tcb_error *he
     snprintf(c->role, sizeof c->role, "%s", tcb_role_name(job->split->role));
     snprintf(c->method, sizeof c->method, "%s", job->method->label);
     snprintf(c->method_impl, sizeof c->method_impl, "%s", job->ops->name);
+    const char *plugin = tcb_registry_file(job->ops);
+    if (plugin) {
+        snprintf(c->plugin_path, sizeof c->plugin_path, "%s", plugin);
+        snprintf(c->plugin_digest, sizeof c->plugin_digest, "%s", tcb_registry_digest(job->ops));
+        c->plugin_abi = job->ops->abi_version;
+    }
     snprintf(c->git_revision, sizeof c->git_revision, "%s", job->git_revision);
     snprintf(c->split_path, sizeof c->split_path, "%s", job->split_path);
     c->seed = job->seed;
@@ -207,8 +218,8 @@ static void reconstruction_cd(const tcb_cell_job *job, void *self, int i, int j,
     } else if (!pts || n <= 0)
         tcb_fail(merr, TCB_ERR_INTERNAL, "reconstruct frame %d (pair %d->%d): returned no points",
                  frame, i, j);
-    else if (!tcb_all_finite(pts, (size_t)n * 3))
-        tcb_fail(merr, TCB_ERR_NUMERIC,
+    else if (!tcb_all_finite(pts, (size_t)n * 3)) /* the method's output is wrong: a failed cell */
+        tcb_fail(merr, TCB_ERR_INPUT,
                  "reconstruct frame %d (pair %d->%d): returned a non-finite point", frame, i, j);
     else
         tcb_chamfer(pts, n, tcb_seq_frame(seq, frame), seq->n_verts, cd, herr);
@@ -220,9 +231,10 @@ static void reconstruction_cd(const tcb_cell_job *job, void *self, int i, int j,
 }
 
 /* The method's transfer of frame i's GT vertices to frame j into moved,
- * checked finite; k numbers the pair in messages. */
-static int transfer_pair(const tcb_cell_job *job, void *self, int i, int j, int k, tcb_rng *rng, float *moved,
-                         tcb_error *merr)
+ * checked (tcb_transfer_check against the shape index); k numbers the pair
+ * in messages. */
+static int transfer_pair(const tcb_cell_job *job, void *self, int i, int j, int k, tcb_rng *rng,
+                         const tcb_nn *shape, float *moved, tcb_error *merr)
 {
     const tcb_sequence *seq = job->seq;
     int nv = seq->n_verts;
@@ -232,9 +244,9 @@ static int transfer_pair(const tcb_cell_job *job, void *self, int i, int j, int 
         tcb_error_prefix(merr, "transfer %d->%d (pair %d): ", i, j, k);
         return rc;
     }
-    if (!tcb_all_finite(moved, (size_t)nv * 3))
-        return tcb_fail(merr, TCB_ERR_NUMERIC, "transfer %d->%d (pair %d): returned a non-finite point", i, j, k);
-    return TCB_OK;
+    if ((rc = tcb_transfer_check(shape, seq, j, moved, merr)))
+        tcb_error_prefix(merr, "transfer %d->%d (pair %d): ", i, j, k);
+    return rc;
 }
 
 /* Pair k of the split into rec and the summary; with `cap`, its metrics
@@ -250,7 +262,7 @@ static void eval_pair(const tcb_cell_job *job, void *self, int k, eval_bufs *b,
     snprintf(label, sizeof label, "eval/%s/%s/%d", job->dataset->name, seq->name, k);
     tcb_rng rng;
     tcb_rng_seed_stream(&rng, (uint64_t)job->seed, label);
-    if (transfer_pair(job, self, i, j, k, &rng, b->moved, merr)) return;
+    if (transfer_pair(job, self, i, j, k, &rng, b->shape, b->moved, merr)) return;
     double cd = NAN;
     if (job->ops->reconstruct) {
         double cd_i = 0, cd_j = 0;
@@ -277,8 +289,8 @@ static void eval_pair(const tcb_cell_job *job, void *self, int k, eval_bufs *b,
  * as the method gave them, not projected: DynoSurf scores its predicted
  * vertices) into rec. Each transfer draws from a stream of its own frames,
  * the same whether or not the pairs are evaluated too. */
-static void eval_clip(const tcb_cell_job *job, void *self, int c, int first, float *moved, tcb_clip_record *rec,
-                      tcb_error *merr)
+static void eval_clip(const tcb_cell_job *job, void *self, int c, int first, const tcb_nn *shape, float *moved,
+                      tcb_clip_record *rec, tcb_error *merr)
 {
     const tcb_sequence *seq = job->seq;
     int s = job->clips->starts[c];
@@ -289,7 +301,7 @@ static void eval_clip(const tcb_cell_job *job, void *self, int c, int first, flo
         snprintf(label, sizeof label, "clip/%s/%s/%d/%d", job->dataset->name, seq->name, s, t);
         tcb_rng rng;
         tcb_rng_seed_stream(&rng, (uint64_t)job->seed, label);
-        if (transfer_pair(job, self, s, s + t, first + t - 1, &rng, moved, merr)) return;
+        if (transfer_pair(job, self, s, s + t, first + t - 1, &rng, shape, moved, merr)) return;
         rec->err[t - 1] = tcb_corr_frame(moved, tcb_seq_frame(seq, s + t), seq->n_verts);
         rec->corr += rec->err[t - 1] / CLIP_PAIRS;
     }
@@ -338,7 +350,7 @@ static void evaluate_clips(const tcb_cell_job *job, void *self, eval_bufs *b, tc
     for (int k = 0; k < clips->n_clips && !merr->code; k++) {
         int done = first + k * CLIP_PAIRS;
         if (stop_requested(job, done, total, herr)) return;
-        eval_clip(job, self, k, done, b->moved, &c->clips[k], merr);
+        eval_clip(job, self, k, done, b->shape, b->moved, &c->clips[k], merr);
         tcb_stat_push(&c->summary.corr, c->clips[k].corr);
         tcb_report_progress(&job->reporter, done + CLIP_PAIRS, total, label);
     }

@@ -26,6 +26,12 @@
  * methods take cfg's settings instead. (harness/run_config.c) */
 int tcb_run_dir_claim_methods(const tcb_config *cfg, const char *run_dir, const tcb_run_opts *opts,
                               unsigned char *refused, tcb_error *refusal, tcb_error *err);
+/* The methods of cfg a run would refuse in run_dir (refused[k] = 1: their
+ * "method", "params" or plug-in digest differ from the record), found
+ * without writing anything, for `tcbench cells`; nothing is refused when
+ * the directory has no record or an unreadable one. */
+int tcb_run_dir_refusals(const tcb_config *cfg, const char *run_dir, const tcb_run_opts *opts,
+                         unsigned char *refused, tcb_error *err);
 /* The same for `tcbench score`, whose cell is no config method's: only a
  * setting every cell depends on is refused (`force`: taken over), with a
  * hint for score; differing methods keep their record. */

@@ -258,6 +258,8 @@ typedef struct list_walk {
     FILE *out;
     const char *run_dir;
     const tcb_run_opts *opts;
+    const tcb_config *cfg;
+    const unsigned char *refused; /* [n_methods] 1: a run leaves the method's cells alone */
 } list_walk;
 
 static int list_cell(void *ctx, const tcb_grid_cell *c)
@@ -265,17 +267,25 @@ static int list_cell(void *ctx, const tcb_grid_cell *c)
     const list_walk *w = ctx;
     char state[TCB_PATH_MAX];
     cell_state(w->run_dir, w->opts, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state);
-    fprintf(w->out, "%5d  %-12s %-20s %-24s %4d  %s\n", c->id, c->dataset->name, c->sequence->name,
-            c->method->label, c->seed, state);
+    /* Its cell there is another method's under this label: a run refuses
+     * to touch it, so it is not this config's "done". */
+    const char *other = w->refused[c->method - w->cfg->methods] ? " (other settings)" : "";
+    fprintf(w->out, "%5d  %-12s %-20s %-24s %4d  %s%s\n", c->id, c->dataset->name, c->sequence->name,
+            c->method->label, c->seed, state, other);
     return TCB_OK;
 }
 
 int tcb_run_list_cells(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_error *err)
 {
-    (void)err;
-    list_walk w = {out, opts->output ? opts->output : cfg->output, opts};
-    fprintf(out, "%5s  %-12s %-20s %-24s %4s  %s\n", "id", "dataset", "sequence", "method", "seed", "state");
-    return tcb_grid_for_each(cfg, list_cell, &w);
+    list_walk w = {out, opts->output ? opts->output : cfg->output, opts, cfg, NULL};
+    unsigned char *refused = calloc((size_t)cfg->n_methods + 1, 1);
+    int rc = refused ? tcb_run_dir_refusals(cfg, w.run_dir, opts, refused, err)
+                     : tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
+    w.refused = refused;
+    if (!rc) fprintf(out, "%5s  %-12s %-20s %-24s %4s  %s\n", "id", "dataset", "sequence", "method", "seed", "state");
+    if (!rc) rc = tcb_grid_for_each(cfg, list_cell, &w);
+    free(refused);
+    return rc;
 }
 
 /* ---- tcbench status ---------------------------------------------------- */

@@ -17,6 +17,10 @@
  * is compared, so the same config is still the same run from another
  * machine (other data roots, plug-in paths, cache and splits directories),
  * with other threads, under another name, or with --cell, --shard, --only.
+ * A method of a plug-in is recorded with the digest of the plug-in's file
+ * (plugin_fnv1a64): a rebuilt plug-in is other code under the same label,
+ * refused like changed params (a record made before digests were has none,
+ * and takes this run's).
  * --force takes the directory over for the new config (its cells are
  * recomputed as they are selected); another --out keeps both. */
 #include <errno.h>
@@ -30,6 +34,7 @@
 #include "harness/harness_internal.h"
 #include "tcb/fsutil.h"
 #include "tcb/json.h"
+#include "tcb/registry.h"
 
 /* Keys of the normalized config (config_dump.c) that change no cell. */
 static const char *const free_keys[] = {"name", "output", "splits_dir", "cache_dir", "plugins", "threads",
@@ -258,6 +263,33 @@ typedef struct claim {
     tcb_error *refusal;          /* why, TCB_OK when nothing was refused */
 } claim;
 
+/* This run's config as the directory records it: the normalized config,
+ * each plug-in method with its file's digest. NULL when out of memory. */
+static cJSON *record_of(const tcb_config *cfg)
+{
+    cJSON *r = cJSON_Parse(cfg->json_text);
+    int k = 0;
+    for (cJSON *m = r ? first(r, "methods") : NULL; m && k < cfg->n_methods; m = m->next, k++) {
+        const tcb_method_ops *ops = tcb_registry_find(cfg->methods[k].method);
+        const char *digest = ops ? tcb_registry_digest(ops) : NULL;
+        if (digest && !cJSON_AddStringToObject(m, "plugin_fnv1a64", digest)) {
+            cJSON_Delete(r);
+            return NULL;
+        }
+    }
+    return r;
+}
+
+/* The record's text, as config.json holds it. malloc'ed; NULL when out of
+ * memory. */
+static char *record_text(const tcb_config *cfg)
+{
+    cJSON *r = record_of(cfg);
+    char *text = r ? cJSON_Print(r) : NULL;
+    cJSON_Delete(r);
+    return text;
+}
+
 /* The refusal of a setting every cell depends on, with the way out that
  * fits the command. */
 static int refuse_all(const claim *c, const char *where, const char *a, const char *b, tcb_error *err)
@@ -322,9 +354,15 @@ static int compare_configs(const claim *c, const cJSON *was, const cJSON *now, u
     cell_settings(x), cell_settings(y);
     int rc = shared_difference(x, y, where, sizeof where, a, b, sizeof a) ? refuse_all(c, where, a, b, err) : TCB_OK;
     int k = 0;
-    for (const cJSON *m = first(y, "methods"); m && !rc; m = m->next, k++) {
-        if (!method_difference(named(item(x, "methods"), name_of(m)), m, where, sizeof where, a, b, sizeof a))
-            continue;
+    for (cJSON *m = first(y, "methods"); m && !rc; m = m->next, k++) {
+        cJSON *w = named(item(x, "methods"), name_of(m));
+        /* A digest compares only with a digest: a record made before them
+         * has none, and a listing that loads no plug-in knows none. */
+        if (!w || !item(w, "plugin_fnv1a64") || !item(m, "plugin_fnv1a64")) {
+            cJSON_DeleteItemFromObjectCaseSensitive(m, "plugin_fnv1a64");
+            if (w) cJSON_DeleteItemFromObjectCaseSensitive(w, "plugin_fnv1a64");
+        }
+        if (!method_difference(w, m, where, sizeof where, a, b, sizeof a)) continue;
         /* --force recomputes what it selects; the record keeps the rest,
          * and a method this run does not select is not its to refuse. */
         int selected = tcb_run_selected(c->opts, &c->cfg->methods[k]), forced = c->opts->force && selected;
@@ -340,7 +378,7 @@ static int compare_configs(const claim *c, const cJSON *was, const cJSON *now, u
  * config, or this config where --force takes the directory over. */
 static int grow_record(const claim *c, char **text, tcb_error *err)
 {
-    cJSON *was = NULL, *now = cJSON_Parse(c->cfg->json_text);
+    cJSON *was = NULL, *now = record_of(c->cfg);
     int rc = now ? tcb_json_load(c->path, &was, err) : tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
     if (rc == TCB_ERR_INPUT)
         tcb_error_prefix(err, "the run directory's record of its config is unreadable (--force replaces it): ");
@@ -382,7 +420,9 @@ static int claim_dir(const claim *c, const char *run_dir, tcb_error *err)
     int rc = tcb_path_join(mine, sizeof mine, err, "%s.tmp-%ld-claim", c->path, (long)getpid());
     if (rc) return rc;
     tcb_remove_stale_temps(run_dir, "config.json.tmp-");
-    rc = write_record(mine, c->path, c->cfg->json_text, err);
+    char *record = record_text(c->cfg);
+    rc = record ? write_record(mine, c->path, record, err) : tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
+    free(record);
     if (rc) return rc;
     if (link(mine, c->path) == 0) return unlink(mine), TCB_OK;
     unlink(mine);
@@ -410,6 +450,25 @@ int tcb_run_dir_claim(const tcb_config *cfg, const char *run_dir, int force, tcb
     tcb_error refusal = {0};
     claim c = {.cfg = cfg, .opts = &opts, .for_score = 1, .refusal = &refusal};
     return claim_for(&c, run_dir, err);
+}
+
+int tcb_run_dir_refusals(const tcb_config *cfg, const char *run_dir, const tcb_run_opts *opts,
+                         unsigned char *refused, tcb_error *err)
+{
+    memset(refused, 0, (size_t)cfg->n_methods);
+    tcb_error refusal = {0}, whole = {0};
+    claim c = {.cfg = cfg, .opts = opts, .refused = refused, .refusal = &refusal};
+    int rc = tcb_path_join(c.path, sizeof c.path, err, "%s/config.json", run_dir);
+    if (rc || !tcb_is_file(c.path)) return rc;
+    cJSON *was = NULL, *now = record_of(cfg);
+    unsigned char *keep_was = calloc((size_t)cfg->n_methods + 1, 1);
+    /* An unreadable record, or a config refused as a whole, is the run's to
+     * say: the listing shows the cells as they are. */
+    if (now && keep_was && tcb_json_load(c.path, &was, &whole) == TCB_OK) compare_configs(&c, was, now, keep_was, &whole);
+    else if (!now || !keep_was) rc = tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
+    cJSON_Delete(was), cJSON_Delete(now);
+    free(keep_was);
+    return rc;
 }
 
 int tcb_run_dir_claim_methods(const tcb_config *cfg, const char *run_dir, const tcb_run_opts *opts,

@@ -5,11 +5,17 @@
 #include "tcb/registry.h"
 
 #include <dlfcn.h>
+#include <errno.h>
+#include <inttypes.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "methods/builtin.h"
+#include "tcb/fsutil.h"
+#include "tcb/hash.h"
+#include "tcb/version.h"
 
 #define MAX_METHODS 256
 
@@ -28,7 +34,8 @@ static const tcb_method_ops *const builtins[] = {
 
 typedef struct plugin_entry {
     const tcb_method_ops *ops;
-    char *origin; /* the plug-in's path */
+    char *origin;     /* the plug-in's path, resolved (realpath) */
+    char digest[17];  /* FNV-1a 64 of the file, hex: which build of it ran */
 } plugin_entry;
 
 static plugin_entry plugins[MAX_METHODS];
@@ -55,12 +62,34 @@ const tcb_method_ops *tcb_registry_find(const char *name)
     return NULL;
 }
 
+const char *tcb_registry_digest(const tcb_method_ops *ops)
+{
+    for (int k = 0; k < n_plugins; k++)
+        if (plugins[k].ops == ops) return plugins[k].digest;
+    return NULL;
+}
+
+const char *tcb_registry_file(const tcb_method_ops *ops)
+{
+    for (int k = 0; k < n_plugins; k++)
+        if (plugins[k].ops == ops) return plugins[k].origin;
+    return NULL;
+}
+
+/* [a-z0-9_]+, as tcb/method.h promises: a name is a word in configs,
+ * directories and tables. */
 static int valid_name(const char *name)
 {
     if (!name || !*name || strlen(name) >= 64) return 0;
     for (const char *p = name; *p; p++)
-        if (!((*p >= 'a' && *p <= 'z') || (*p >= '0' && *p <= '9') || *p == '_' || *p == '-')) return 0;
+        if (!((*p >= 'a' && *p <= 'z') || (*p >= '0' && *p <= '9') || *p == '_')) return 0;
     return 1;
+}
+
+/* The first of the functions every method must define that ops lacks. */
+static const char *missing_function(const tcb_method_ops *ops)
+{
+    return !ops->create ? "create" : !ops->fit ? "fit" : !ops->transfer ? "transfer" : !ops->destroy ? "destroy" : NULL;
 }
 
 /* A table must be complete enough for the harness to call it blindly. */
@@ -69,30 +98,50 @@ static int check_table(const tcb_method_ops *ops, const char *path, tcb_error *e
     if (!ops) return tcb_fail(err, TCB_ERR_INPUT, "%s: plug-in returned a NULL method table", path);
     if (ops->abi_version < TCB_METHOD_ABI_OLDEST || ops->abi_version > TCB_METHOD_ABI_VERSION)
         return tcb_fail(err, TCB_ERR_INPUT,
-                        "%s: method ABI version %d, this tcbench reads %d to %d (rebuild the plug-in)", path,
-                        ops->abi_version, TCB_METHOD_ABI_OLDEST, TCB_METHOD_ABI_VERSION);
+                        "%s: method ABI version %d, this tcbench (%s) reads %d to %d: rebuild the plug-in against "
+                        "this tcbench's headers (<prefix>/include/tcb/method.h of its install, or include/ of its "
+                        "source tree)",
+                        path, ops->abi_version, TCB_VERSION, TCB_METHOD_ABI_OLDEST, TCB_METHOD_ABI_VERSION);
     if (!valid_name(ops->name))
-        return tcb_fail(err, TCB_ERR_INPUT, "%s: method name '%s' must be 1-63 characters of [a-z0-9_-]", path,
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: method name '%s' must be 1-63 characters of [a-z0-9_]", path,
                         ops->name ? ops->name : "(null)");
-    if (!ops->create || !ops->fit || !ops->transfer || !ops->destroy)
-        return tcb_fail(err, TCB_ERR_INPUT, "%s: method '%s' lacks one of create, fit, transfer, destroy", path,
-                        ops->name);
+    const char *missing = missing_function(ops);
+    if (missing)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: method '%s' has no %s (create, fit, transfer and destroy are required)",
+                        path, ops->name, missing);
     if (!ops->save != !ops->load)
         return tcb_fail(err, TCB_ERR_INPUT, "%s: method '%s' must define both save and load, or neither", path,
                         ops->name);
-    if (tcb_registry_find(ops->name))
-        return tcb_fail(err, TCB_ERR_INPUT, "%s: a method named '%s' is already registered", path, ops->name);
+    const tcb_method_ops *other = tcb_registry_find(ops->name);
+    if (other)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: a method named '%s' is already registered from %s", path, ops->name,
+                        tcb_registry_file(other) ? tcb_registry_file(other) : "tcbench itself (built in)");
+    return TCB_OK;
+}
+
+/* FNV-1a 64 of the file at path, as 16 hex digits. */
+static int file_digest(const char *path, char hex[17], tcb_error *err)
+{
+    char *data;
+    size_t n;
+    int rc = tcb_read_file(path, &data, &n, err);
+    if (rc) return rc;
+    snprintf(hex, 17, "%016" PRIx64, tcb_fnv1a64(TCB_FNV1A64_OFFSET, data, n));
+    free(data);
     return TCB_OK;
 }
 
 int tcb_registry_load_plugin(const char *path, tcb_error *err)
 {
-    /* dlopen searches the library path for names without a slash; a plug-in
-     * is always named by path, so make relative names explicit. */
-    char full[4096];
-    snprintf(full, sizeof full, "%s%s", strchr(path, '/') ? "" : "./", path);
+    /* One file is one plug-in however it is named (--plugin and a config's
+     * "plugins" may name it relatively and absolutely): compared resolved. */
+    char full[PATH_MAX];
+    if (!realpath(path, full)) return tcb_fail(err, TCB_ERR_INPUT, "%s: cannot load plug-in: %s", path, strerror(errno));
     for (int k = 0; k < n_plugins; k++)
         if (strcmp(plugins[k].origin, full) == 0) return TCB_OK; /* already loaded */
+    char digest[17];
+    int rc = file_digest(full, digest, err);
+    if (rc) return rc;
     void *handle = dlopen(full, RTLD_NOW | RTLD_LOCAL);
     if (!handle) return tcb_fail(err, TCB_ERR_INPUT, "%s: cannot load plug-in: %s", path, dlerror());
     tcb_plugin_entry_fn entry;
@@ -109,7 +158,7 @@ int tcb_registry_load_plugin(const char *path, tcb_error *err)
                         MAX_METHODS - n_plugins);
     }
     for (int k = 0; k < count; k++) {
-        int rc = check_table(tables[k], path, err);
+        rc = check_table(tables[k], path, err);
         for (int m = 0; !rc && m < k; m++)
             if (strcmp(tables[m]->name, tables[k]->name) == 0)
                 rc = tcb_fail(err, TCB_ERR_INPUT, "%s: method '%s' is listed twice", path, tables[k]->name);
@@ -121,6 +170,7 @@ int tcb_registry_load_plugin(const char *path, tcb_error *err)
     for (int k = 0; k < count; k++) {
         plugins[n_plugins].ops = tables[k];
         plugins[n_plugins].origin = strdup(full);
+        memcpy(plugins[n_plugins].digest, digest, sizeof digest);
         n_plugins++;
     }
     return TCB_OK;

@@ -20,7 +20,13 @@
  * with noise of 0.05 D added, at fit of 0.04 D and more. The median, not
  * the mean: a method that went wrong on some vertices keeps most of them
  * on the shape. With normalization "none" N is the identity: nothing is
- * refused. */
+ * refused as raw.
+ *
+ * Points with fit beyond TCB_FRAME_FAR box diagonals are refused in any
+ * frame: a median point a whole diagonal away from every vertex of every
+ * frame is no point of the shape (vertex ids written as x, a unit a
+ * thousand times off), which the raw test cannot tell when the
+ * normalisation is near the identity. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -81,6 +87,11 @@ int tcb_score_check_frame(const tcb_nn *shape, const float *verts_j, int nv, con
     tcb_frame_fit f;
     int rc = tcb_frame_fit_measure(shape, verts_j, nv, points, n, shift, scale, &f, err);
     if (rc) return rc;
+    if (f.fit > TCB_FRAME_FAR * f.diag)
+        return tcb_fail(err, TCB_ERR_INPUT,
+                        "the points lie a median %.3g box diagonals from the sequence's vertices (more than %g): "
+                        "no points of the shape (vertex ids or another unit written as coordinates?)",
+                        f.fit / f.diag, TCB_FRAME_FAR);
     if (f.fit > TCB_FRAME_RAW_RATIO * f.fit_raw && f.fit > TCB_FRAME_RAW_MIN * f.diag)
         return tcb_fail(err, TCB_ERR_INPUT,
                         "the points lie a median %.3g box diagonals from the sequence's vertices, %.3g once "

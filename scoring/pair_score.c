@@ -1,5 +1,5 @@
 /* The one path from a pair's prediction to a cell's numbers
- * (harness/harness_internal.h): the projection onto frame j's GT vertices, the
+ * (scoring/scoring.h): the projection onto frame j's GT vertices, the
  * paper's metrics, the geodesic error, the pair's record and the summary.
  * A method's cells (harness/cell.c) and scored cells (harness/score.c)
  * both come through here. */

@@ -16,9 +16,10 @@ static const char *const TOP_KEYS[] = {
     "format",       "dataset",         "sequence", "role",        "method",
     "method_impl",  "params",          "seed",     "status",      "message",
     "git_revision", "tcbench_version", "timings",  "peak_rss_kb", "split",
-    "summary",      "pair_columns",    "pairs",    "clips",       "surface", NULL};
+    "summary",      "pair_columns",    "pairs",    "clips",       "surface", "plugin", NULL};
 static const char *const TIMING_KEYS[] = {"load_s", "fit_s", "eval_s", NULL};
 static const char *const SPLIT_KEYS[] = {"path", "seed", "n_pairs", NULL};
+static const char *const PLUGIN_KEYS[] = {"path", "fnv1a64", "abi", NULL};
 static const char *const SUMMARY_KEYS[] = {"n_pairs", "sl2",     "sl2sq",   "rank",
                                            "auc",     "cd",      "pck",     "geo",
                                            "geo_auc", "geo_pck", "geo_unreachable", "corr",
@@ -432,12 +433,30 @@ static int load_timings_split(const cJSON *root, const char *where, tcb_cell_res
     return TCB_OK;
 }
 
+/* "plugin", when the cell's method came from one (absent: built in, or a
+ * cell written before the key). */
+static int load_plugin(const cJSON *root, const char *where, tcb_cell_result *c, tcb_error *err)
+{
+    if (!cJSON_HasObjectItem(root, "plugin")) return TCB_OK;
+    char sub[TCB_ERRMSG_MAX];
+    const cJSON *o;
+    long long v;
+    int rc = object_key(root, "plugin", where, PLUGIN_KEYS, &o, sub, sizeof sub, err);
+    if (rc || (rc = copy_str(o, "path", sub, c->plugin_path, sizeof c->plugin_path, err)) ||
+        (rc = copy_str(o, "fnv1a64", sub, c->plugin_digest, sizeof c->plugin_digest, err)) ||
+        (rc = tcb_json_int(o, "abi", sub, 1, 0, 1, INT_MAX, &v, err)))
+        return rc;
+    c->plugin_abi = (int)v;
+    return TCB_OK;
+}
+
 static int cell_from_json(const cJSON *root, const char *path, tcb_cell_result *c,
                           tcb_error *err)
 {
     int n_cols;
     int rc = tcb_json_expect_object(root, path, err);
-    if (rc || (rc = load_header(root, path, c, err)) || (rc = load_params(root, path, c, err)) ||
+    if (rc || (rc = load_header(root, path, c, err)) || (rc = load_plugin(root, path, c, err)) ||
+        (rc = load_params(root, path, c, err)) ||
         (rc = load_timings_split(root, path, c, err)) ||
         (rc = load_summary(root, path, &c->summary, err)) ||
         (rc = load_pair_columns(root, path, &n_cols, err)) ||

@@ -280,6 +280,14 @@ cJSON *tcb_cell_to_json(const char *path, const tcb_cell_result *c, tcb_error *e
         add_num(&b, sp, "seed", (double)c->split_seed);
         add_num(&b, sp, "n_pairs", c->n_pairs);
     }
+    if (c->plugin_path[0]) {
+        cJSON *pl = add(&b, root, "plugin", cJSON_CreateObject());
+        if (pl) {
+            add_str(&b, pl, "path", c->plugin_path);
+            add_str(&b, pl, "fnv1a64", c->plugin_digest);
+            add_num(&b, pl, "abi", c->plugin_abi);
+        }
+    }
     add_summary(&b, root, &c->summary);
     add_pairs(&b, root, c);
     add_clips(&b, root, c);

@@ -45,11 +45,18 @@ void tcb_predictions_close(tcb_predictions *p);
  * normalised as the split normalises frame j ((p - shift) / scale, shift
  * its norm_shift[j], scale norm_scale), D the diagonal of frame j's
  * bounding box. The points are refused (raw coordinates) when fit >
- * TCB_FRAME_RAW_RATIO * fit_raw and fit > TCB_FRAME_RAW_MIN * D.
+ * TCB_FRAME_RAW_RATIO * fit_raw and fit > TCB_FRAME_RAW_MIN * D, and
+ * (no points of the shape) when fit > TCB_FRAME_FAR * D.
  * check_frame returns TCB_OK or TCB_ERR_INPUT with a message giving both
  * medians; the caller adds the split's normalisation and the way out. */
 #define TCB_FRAME_RAW_RATIO 2.0
 #define TCB_FRAME_RAW_MIN 0.01
+/* And points whose median distance to the sequence's vertices exceeds
+ * TCB_FRAME_FAR box diagonals are refused whatever their frame: they are
+ * no points of the shape at all (vertex ids written as coordinates, another
+ * unit). A method's worst honest guess, an untrained network's output near
+ * the origin of the normalised frame, lies within one diagonal. */
+#define TCB_FRAME_FAR 1.0
 typedef struct tcb_frame_fit {
     double diag;          /* D */
     double fit, fit_raw;  /* median distances to the nearest vertex (INFINITY: beyond the search's range) */

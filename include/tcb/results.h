@@ -52,6 +52,10 @@
  * (err_t: tcb_corr_frame at the clip's frame t; corr their mean); a cell
  * without clips has neither key (n_clips 0, corr.n 0: "-" in the Corr
  * column), and a clips-only cell has no pairs (split.n_pairs 0).
+ * A cell of a plug-in's method (tcb/registry.h) records which build ran
+ * it: "plugin": {"path", "fnv1a64", "abi"} (the file, its digest, the
+ * table's abi_version); a built-in method's cell, and one written before
+ * the key, has none (plugin_path "").
  * The reconstruction metrics (tcb/metrics.h, TCB_RECON_*; docs/protocol.md,
  * "Reconstruction metrics") came later too: a cell whose method gives
  * surfaces has "summary.cdl2", "summary.nc", "summary.fscore05" and
@@ -109,6 +113,9 @@ typedef struct tcb_cell_result {
     char role[16];             /* "train" | "validation" | "test" */
     char method[64];           /* the config's label for the method */
     char method_impl[64];      /* the registered method name */
+    char plugin_path[4096];    /* a plug-in's method: the file it came from; "" built in */
+    char plugin_digest[17];    /* and the file's FNV-1a 64 (hex) when the cell ran */
+    int plugin_abi;            /* and its table's abi_version */
     char *params_json;         /* malloc'ed, compact JSON object */
     int seed;
     tcb_cell_status status;

@@ -9,7 +9,9 @@
  *               cost that many seconds before
  *   faulty      fails on purpose: "mode" = "fit" (an error in fit),
  *               "numeric" (TCB_ERR_NUMERIC from transfer at pair `at`),
- *               "nan" (a NaN point from transfer at pair `at`)
+ *               "nan" (a NaN point from transfer at pair `at`), "huge"
+ *               (one finite point at 1e30), "ids" (vertex ids written as
+ *               the x coordinate, from pair `at` on): a plug-in's bugs
  *   thread_probe  identity transfer that fails unless it runs with the
  *               OpenMP thread count its fit was given (ctx->n_threads):
  *               the cell's thread budget covers the evaluation too */
@@ -27,7 +29,7 @@ typedef struct model {
     int delay_ms;
     double noise;
     double offset;   /* drawn in fit from the seed: checks save/load round trips */
-    int mode;        /* faulty: 0 fit, 1 numeric, 2 nan */
+    int mode;        /* faulty: 0 fit, 1 numeric, 2 nan, 3 huge, 4 ids */
     int at;          /* faulty: the failing transfer call */
     double resumed_fit_s; /* slow_noisy: reported through ctx->resumed_fit_s */
     int calls;
@@ -49,9 +51,9 @@ static int parse(const char *params_json, const char *name, model *m, tcb_error 
         else if (strcmp(it->string, "resumed_fit_s") == 0 && cJSON_IsNumber(it))
             m->resumed_fit_s = it->valuedouble;
         else if (strcmp(it->string, "mode") == 0 && cJSON_IsString(it)) {
-            const char *modes[] = {"fit", "numeric", "nan"};
+            const char *modes[] = {"fit", "numeric", "nan", "huge", "ids"};
             m->mode = -1;
-            for (int k = 0; k < 3; k++)
+            for (int k = 0; k < (int)(sizeof modes / sizeof modes[0]); k++)
                 if (strcmp(it->valuestring, modes[k]) == 0) m->mode = k;
             if (m->mode < 0)
                 rc = tcb_fail(err, TCB_ERR_INPUT, "%s.params.mode: unknown mode '%s'", name,
@@ -156,9 +158,13 @@ static int fy_transfer(void *self, const tcb_sequence *seq, int i, int j, const 
     (void)seq, (void)i, (void)j, (void)rng;
     model *m = self;
     memcpy(out, src, (size_t)n * 3 * sizeof(float));
-    if (m->calls++ != m->at) return TCB_OK;
+    if (m->mode == 4 && m->calls++ >= m->at) {
+        for (int v = 0; v < n; v++) out[3 * v] = (float)v, out[3 * v + 1] = out[3 * v + 2] = 0;
+        return TCB_OK;
+    }
+    if (m->mode == 4 || m->calls++ != m->at) return TCB_OK;
     if (m->mode == 1) return tcb_fail(err, TCB_ERR_NUMERIC, "faulty: loss is NaN");
-    out[0] = NAN;
+    out[n / 2 * 3 + 1] = m->mode == 3 ? 1e30f : NAN;
     return TCB_OK;
 }
 

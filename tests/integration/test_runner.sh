@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Runner behaviour beyond the happy path: a method failing in fit or
-# transfer (error, NaN) yields a failed/diverged cell and the run goes on
-# (exit 1 for the failed one, listed at the end);
+# transfer yields a failed cell (a diverged one for TCB_ERR_NUMERIC, a
+# training that diverged), and the run goes on (exit 1 for the failed ones,
+# listed at the end); a transfer's bad points (NaN, beyond the k-NN range,
+# vertex ids as coordinates) fail their own cell, naming pair and vertex;
 # the cell's thread count holds in its evaluation too;
 # optional objdir datasets are skipped when absent, required ones are an
 # error naming the path; an objdir sequence loads through the cache.
@@ -24,12 +26,14 @@ cat > faults.json <<'JSON'
   "methods": [ { "name": "fit_fails", "method": "faulty", "params": { "mode": "fit" } },
                { "name": "numeric", "method": "faulty", "params": { "mode": "numeric", "at": 3 } },
                { "name": "nan", "method": "faulty", "params": { "mode": "nan", "at": 0 } },
+               { "name": "huge", "method": "faulty", "params": { "mode": "huge", "at": 2 } },
+               { "name": "ids", "method": "faulty", "params": { "mode": "ids", "at": 1 } },
                { "name": "nearest" } ] }
 JSON
 rc=0
 "$TCBENCH" run faults.json --plugin "$plugin" --quiet 2> faults.log || rc=$?
 [ "$rc" -eq 1 ] || { echo "FAIL: a run with a failed cell exited $rc"; cat faults.log; exit 1; }
-grep -qF "cells: 4 in all, 4 computed, 0 already done, 1 failed, 2 diverged" faults.log || { cat faults.log; exit 1; }
+grep -qF "cells: 6 in all, 6 computed, 0 already done, 4 failed, 1 diverged" faults.log || { cat faults.log; exit 1; }
 grep -qxF "synth/quadruped_walk/fit_fails/seed 0: fit: faulty: refusing to fit" faults.log || { cat faults.log; exit 1; }
 grep -qF "warning: synth/quadruped_walk/numeric/seed 0 diverged" faults.log || { cat faults.log; exit 1; }
 /usr/bin/python3 - <<'PY'
@@ -39,7 +43,9 @@ def cell(m):
 expect = {
     "fit_fails": ("failed", "fit: faulty: refusing to fit"),
     "numeric": ("diverged", "(pair 3): faulty: loss is NaN"),
-    "nan": ("diverged", "(pair 0): returned a non-finite point"),
+    "nan": ("failed", "(pair 0): returned a non-finite point (vertex "),
+    "huge": ("failed", "(pair 2): returned a point beyond ±1e+18 (vertex "),
+    "ids": ("failed", "(pair 1): returned points outside the split's frame: the points lie a median "),
     "nearest": ("ok", ""),
 }
 for m, (status, text) in expect.items():
