@@ -390,15 +390,7 @@ static void record_failure(tcb_cell_result *c, const tcb_error *merr)
 {
     c->status = merr->code == TCB_ERR_NUMERIC ? TCB_CELL_DIVERGED : TCB_CELL_FAILED;
     snprintf(c->message, sizeof c->message, "%s", merr->msg);
-    free(c->pairs);
-    free(c->clips);
-    free(c->surface);
-    c->pairs = NULL;
-    c->clips = NULL;
-    c->surface = NULL;
-    c->n_pairs = 0;
-    c->n_clips = 0;
-    c->n_surface = 0;
+    tcb_cell_drop_rows(c);
     tcb_summary_init(&c->summary);
 }
 

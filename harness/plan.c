@@ -278,9 +278,10 @@ static int list_cell(void *ctx, const tcb_grid_cell *c)
 int tcb_run_list_cells(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_error *err)
 {
     list_walk w = {out, opts->output ? opts->output : cfg->output, opts, cfg, NULL};
+    /* The plug-ins, for their digests: a rebuilt one's cells are not done. */
     unsigned char *refused = calloc((size_t)cfg->n_methods + 1, 1);
-    int rc = refused ? tcb_run_dir_refusals(cfg, w.run_dir, opts, refused, err)
-                     : tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
+    int rc = refused ? tcb_harness_load_plugins(cfg, err) : tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
+    if (!rc) rc = tcb_run_dir_refusals(cfg, w.run_dir, opts, refused, err);
     w.refused = refused;
     if (!rc) fprintf(out, "%5s  %-12s %-20s %-24s %4s  %s\n", "id", "dataset", "sequence", "method", "seed", "state");
     if (!rc) rc = tcb_grid_for_each(cfg, list_cell, &w);

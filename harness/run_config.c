@@ -218,8 +218,8 @@ static cJSON *method_seeds(const cJSON *m, const cJSON *config)
 
 /* The union of the configs `was` (the record) and `now`: now's settings
  * and paths, and every dataset, sequence, method and seed of either; a
- * method of both keeps was's "method" and "params" where keep_was[k] (k:
- * its index in now's methods), now's otherwise. */
+ * method of both keeps was's "method", "params" and plug-in digest where
+ * keep_was[k] (k: its index in now's methods), now's otherwise. */
 static cJSON *config_union(const cJSON *was, const cJSON *now, const unsigned char *keep_was)
 {
     cJSON *u = cJSON_Duplicate(now, 1), *methods = item(u, "methods");
@@ -234,6 +234,9 @@ static cJSON *config_union(const cJSON *was, const cJSON *now, const unsigned ch
         if (w && keep_was[k]) {
             replace_item(m, "method", cJSON_Duplicate(item(w, "method"), 1));
             replace_item(m, "params", cJSON_Duplicate(item(w, "params"), 1));
+            const cJSON *digest = item(w, "plugin_fnv1a64");
+            if (digest) replace_item(m, "plugin_fnv1a64", cJSON_Duplicate(digest, 1));
+            else cJSON_DeleteItemFromObjectCaseSensitive(m, "plugin_fnv1a64");
         }
         /* A method that runs on every dataset in either config runs on all. */
         if (w && (!item(w, "datasets") || !item(m, "datasets"))) cJSON_DeleteItemFromObjectCaseSensitive(m, "datasets");

@@ -20,9 +20,7 @@ int tcb_transfer_check(const tcb_nn *shape, const tcb_sequence *seq, int j, cons
             return tcb_fail(merr, TCB_ERR_INPUT, "returned a point beyond ±%g (vertex %d: %g %g %g)",
                             (double)TCB_NN_COORD_MAX, v, p[0], p[1], p[2]);
     }
-    int rc = tcb_score_check_frame(shape, tcb_seq_frame(seq, j), nv, moved, nv, seq->norm_shift + 3 * (size_t)j,
-                                   seq->norm_scale, merr);
-    if (rc == TCB_ERR_INPUT)
-        tcb_error_prefix(merr, "returned points outside the split's frame: ");
+    int rc = tcb_score_check_shape(shape, tcb_seq_frame(seq, j), nv, moved, nv, merr);
+    if (rc == TCB_ERR_INPUT) tcb_error_prefix(merr, "returned points off the shape: ");
     return rc;
 }

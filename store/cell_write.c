@@ -311,18 +311,23 @@ int tcb_cell_save(const char *path, const tcb_cell_result *c, tcb_error *err)
     return rc;
 }
 
-void tcb_cell_free(tcb_cell_result *c)
+void tcb_cell_drop_rows(tcb_cell_result *c)
 {
-    if (!c) return;
-    free(c->params_json);
     free(c->pairs);
     free(c->clips);
     free(c->surface);
-    c->params_json = NULL;
     c->pairs = NULL;
     c->clips = NULL;
     c->surface = NULL;
     c->n_pairs = 0;
     c->n_clips = 0;
     c->n_surface = 0;
+}
+
+void tcb_cell_free(tcb_cell_result *c)
+{
+    if (!c) return;
+    free(c->params_json);
+    c->params_json = NULL;
+    tcb_cell_drop_rows(c);
 }

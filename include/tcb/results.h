@@ -150,6 +150,9 @@ int tcb_cell_save(const char *path, const tcb_cell_result *c, tcb_error *err);
 /* Validates format and fields; errors name the file and key. */
 int tcb_cell_load(const char *path, tcb_cell_result *out, tcb_error *err);
 void tcb_cell_free(tcb_cell_result *c);
+/* Frees the cell's rows (pairs, clips, surface frames) and counts them 0,
+ * keeping its identity: what a failed cell keeps. */
+void tcb_cell_drop_rows(tcb_cell_result *c);
 
 /* Every cell file under <run>/cells, sorted by (dataset, sequence, method, seed).
  * *cells is malloc'ed; free each with tcb_cell_free, then the array. */

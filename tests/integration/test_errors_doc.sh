@@ -369,6 +369,40 @@ row "\`--preset\` none of the method's" "$TCBENCH" calibrate --only cc --preset 
 row "\`--threads\` not a list of counts" "$TCBENCH" calibrate --threads 1,,2 --out c.json
 row "\`run --tasks\` without \`--dry-run\`" run split.json --tasks 2
 
+# ---- plug-ins
+section "Plug-ins (\`--plugin SO\`, a config's \`\"plugins\"\`; docs/adding-a-method.md)"
+sanitize=$(grep -q 'TCB_SANITIZE:BOOL=ON' "$TCB_BUILD_DIR/CMakeCache.txt" && echo "-fsanitize=address,undefined" || true)
+plugin() { # plugin OUT [-D...]: tests/integration/centroid_plugin.c built so
+    local out=$1
+    shift
+    "${CC:-cc}" -std=c11 -O2 -shared -fPIC $sanitize "$@" -I"$TCB_SOURCE_DIR/include" \
+        "$TCB_SOURCE_DIR/tests/integration/centroid_plugin.c" -L"$TCB_BUILD_DIR" -ltcbench -lcjson -lm -o "$out"
+}
+plugin libcentroid.so
+row "no such file" "$TCBENCH" --plugin ./none.so methods
+echo "not a shared object" > libtext.so
+row "not a shared object" "$TCBENCH" --plugin ./libtext.so methods
+plugin libnoentry.so -DNO_ENTRY
+row "no entry symbol" "$TCBENCH" --plugin ./libnoentry.so methods
+plugin libfuture.so -DABI=99
+row "a method table of an ABI this tcbench does not read" "$TCBENCH" --plugin ./libfuture.so methods
+plugin libdash.so '-DNAME="my-method"'
+row "a method name outside [a-z0-9_]" "$TCBENCH" --plugin ./libdash.so methods
+plugin libbuiltin.so '-DNAME="nearest"'
+row "the name of a built-in method" "$TCBENCH" --plugin ./libbuiltin.so methods
+cp libcentroid.so libcopy.so
+row "the name of a method of another file" "$TCBENCH" --plugin ./libcentroid.so --plugin ./libcopy.so methods
+plugin libnotransfer.so -DNULL_TRANSFER
+row "a required function missing" "$TCBENCH" --plugin ./libnotransfer.so methods
+conf plug.json '{"plugins": ["libcentroid.so"], "methods": [{"name": "nearest"}, {"name": "centroid"}]}'
+CENTROID_FAULT=huge:quadruped_walk row "a transfer's point beyond the k-NN range (the cell fails; a rerun retries it)" run plug.json
+CENTROID_FAULT=nan:quadruped_walk row "a transfer's non-finite point (the cell fails; a rerun retries it)" run plug.json
+CENTROID_FAULT=ids:quadruped_walk row "a transfer off the shape: vertex ids as x (the cell fails; a rerun retries it)" run plug.json
+run plug.json > /dev/null 2>&1
+plugin libcentroid.so -DSHIFT=0.001f
+row "the plug-in rebuilt with other code (its cells there are refused)" run plug.json
+rm -rf runs
+
 # ---- command line
 section "Command-line flags (every command; checked before anything is read)"
 row "\`--threads 0\`" run split.json --threads 0

@@ -45,7 +45,7 @@ expect = {
     "numeric": ("diverged", "(pair 3): faulty: loss is NaN"),
     "nan": ("failed", "(pair 0): returned a non-finite point (vertex "),
     "huge": ("failed", "(pair 2): returned a point beyond ±1e+18 (vertex "),
-    "ids": ("failed", "(pair 1): returned points outside the split's frame: the points lie a median "),
+    "ids": ("failed", "(pair 1): returned points off the shape: the points lie a median "),
     "nearest": ("ok", ""),
 }
 for m, (status, text) in expect.items():
