@@ -68,6 +68,7 @@ int tcb_cell_identity(const tcb_cell_job *job, tcb_cell_result *c, tcb_error *he
         snprintf(c->plugin_path, sizeof c->plugin_path, "%s", plugin);
         snprintf(c->plugin_digest, sizeof c->plugin_digest, "%s", tcb_registry_digest(job->ops));
         c->plugin_abi = job->ops->abi_version;
+        snprintf(c->plugin_version, sizeof c->plugin_version, "%s", tcb_method_version(job->ops));
     }
     snprintf(c->git_revision, sizeof c->git_revision, "%s", job->git_revision);
     snprintf(c->split_path, sizeof c->split_path, "%s", job->split_path);

@@ -19,7 +19,7 @@ static const char *const TOP_KEYS[] = {
     "summary",      "pair_columns",    "pairs",    "clips",       "surface", "plugin", NULL};
 static const char *const TIMING_KEYS[] = {"load_s", "fit_s", "eval_s", NULL};
 static const char *const SPLIT_KEYS[] = {"path", "seed", "n_pairs", NULL};
-static const char *const PLUGIN_KEYS[] = {"path", "fnv1a64", "abi", NULL};
+static const char *const PLUGIN_KEYS[] = {"path", "fnv1a64", "abi", "version", NULL};
 static const char *const SUMMARY_KEYS[] = {"n_pairs", "sl2",     "sl2sq",   "rank",
                                            "auc",     "cd",      "pck",     "geo",
                                            "geo_auc", "geo_pck", "geo_unreachable", "corr",
@@ -444,7 +444,8 @@ static int load_plugin(const cJSON *root, const char *where, tcb_cell_result *c,
     int rc = object_key(root, "plugin", where, PLUGIN_KEYS, &o, sub, sizeof sub, err);
     if (rc || (rc = copy_str(o, "path", sub, c->plugin_path, sizeof c->plugin_path, err)) ||
         (rc = copy_str(o, "fnv1a64", sub, c->plugin_digest, sizeof c->plugin_digest, err)) ||
-        (rc = tcb_json_int(o, "abi", sub, 1, 0, 1, INT_MAX, &v, err)))
+        (rc = tcb_json_int(o, "abi", sub, 1, 0, 1, INT_MAX, &v, err)) ||
+        (rc = copy_str(o, "version", sub, c->plugin_version, sizeof c->plugin_version, err)))
         return rc;
     c->plugin_abi = (int)v;
     return TCB_OK;

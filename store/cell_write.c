@@ -286,6 +286,7 @@ cJSON *tcb_cell_to_json(const char *path, const tcb_cell_result *c, tcb_error *e
             add_str(&b, pl, "path", c->plugin_path);
             add_str(&b, pl, "fnv1a64", c->plugin_digest);
             add_num(&b, pl, "abi", c->plugin_abi);
+            add_str(&b, pl, "version", c->plugin_version);
         }
     }
     add_summary(&b, root, &c->summary);

@@ -91,6 +91,7 @@ static void cn_destroy(void *self)
 static const tcb_method_ops centroid_nearest = {
     .abi_version = TCB_METHOD_ABI_VERSION,
     .name = "centroid_nearest",
+    .version = "1.0", /* recorded in every cell it computes */
     .description = "nearest vertex after removing the frames' translation (example plug-in)",
     .create = cn_create,
     .fit = cn_fit,

@@ -44,10 +44,11 @@ extern "C" {
  * that declines (TCB_ERR_UNSUPPORTED), 5 `presets`, `train_steps` and the
  * estimate priced by calibrated costs (tcb_cost_estimate.steps, .preset),
  * 6 `units`, `run_unit`, the estimate's unit counts (.units, .n_units) and
- * steps that grow with the frame count (.step_frames); tables of older
- * versions still load, and the harness reads no member their version did
- * not have (their tables end before it; the estimate it zeroes). */
-#define TCB_METHOD_ABI_VERSION 6
+ * steps that grow with the frame count (.step_frames), 7 `version`; tables
+ * of older versions still load, and the harness reads no member their
+ * version did not have (their tables end before it; the estimate it
+ * zeroes). */
+#define TCB_METHOD_ABI_VERSION 7
 #define TCB_METHOD_ABI_OLDEST 1
 
 typedef struct tcb_fit_ctx {
@@ -244,7 +245,20 @@ typedef struct tcb_method_ops {
      * caller's OpenMP thread count; the caller times the calls. */
     const char *const *units;
     int (*run_unit)(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, int unit, tcb_error *err);
+
+    /* Optional (NULL: none; read only from tables of abi_version >= 7). The
+     * method's own version ("1.2", a commit), recorded with a plug-in's
+     * file digest in every cell it computes, so that a result can be
+     * traced to the code that made it. A built-in method's is tcbench's
+     * (the cell's git_revision). */
+    const char *version;
 } tcb_method_ops;
+
+/* The method's version string (tcb_method_ops.version); "" when none. */
+static inline const char *tcb_method_version(const tcb_method_ops *ops)
+{
+    return ops->abi_version >= 7 && ops->version ? ops->version : "";
+}
 
 /* The method of ops gives a surface per frame (tcb_method_ops.surface). */
 static inline int tcb_method_has_surface(const tcb_method_ops *ops)

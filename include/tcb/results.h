@@ -53,9 +53,10 @@
  * without clips has neither key (n_clips 0, corr.n 0: "-" in the Corr
  * column), and a clips-only cell has no pairs (split.n_pairs 0).
  * A cell of a plug-in's method (tcb/registry.h) records which build ran
- * it: "plugin": {"path", "fnv1a64", "abi"} (the file, its digest, the
- * table's abi_version); a built-in method's cell, and one written before
- * the key, has none (plugin_path "").
+ * it: "plugin": {"path", "fnv1a64", "abi", "version"} (the file, its
+ * digest, the table's abi_version and version string, "" when it has
+ * none); a built-in method's cell, and one written before the key, has
+ * none (plugin_path "").
  * The reconstruction metrics (tcb/metrics.h, TCB_RECON_*; docs/protocol.md,
  * "Reconstruction metrics") came later too: a cell whose method gives
  * surfaces has "summary.cdl2", "summary.nc", "summary.fscore05" and
@@ -116,6 +117,7 @@ typedef struct tcb_cell_result {
     char plugin_path[4096];    /* a plug-in's method: the file it came from; "" built in */
     char plugin_digest[17];    /* and the file's FNV-1a 64 (hex) when the cell ran */
     int plugin_abi;            /* and its table's abi_version */
+    char plugin_version[64];   /* and its version string (tcb_method_ops.version; "" none) */
     char *params_json;         /* malloc'ed, compact JSON object */
     int seed;
     tcb_cell_status status;

@@ -20,6 +20,9 @@
 #ifndef NAME
 #define NAME "centroid"
 #endif
+#ifndef VERSION
+#define VERSION "1.0"
+#endif
 #ifdef NO_ENTRY
 #define tcb_plugin_methods not_the_entry
 #endif
@@ -62,7 +65,7 @@ static const tcb_method_ops centroid_ops = {
 #ifndef NULL_TRANSFER
     .transfer = transfer,
 #endif
-    .destroy = destroy};
+    .destroy = destroy, .version = VERSION};
 const tcb_method_ops *const *tcb_plugin_methods(int *count);
 const tcb_method_ops *const *tcb_plugin_methods(int *count)
 {

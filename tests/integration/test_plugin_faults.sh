@@ -66,7 +66,8 @@ import json, sys
 c = json.load(open(sys.argv[1]))
 assert c["status"] == "ok", c["status"]
 assert c["plugin"]["path"] == sys.argv[2], c["plugin"]
-assert len(c["plugin"]["fnv1a64"]) == 16 and c["plugin"]["abi"] >= 6, c["plugin"]
+assert len(c["plugin"]["fnv1a64"]) == 16 and c["plugin"]["abi"] >= 7, c["plugin"]
+assert c["plugin"]["version"] == "1.0", c["plugin"]
 PY
 
 # ---- bad transfers: one cell fails, named; the others stay; a rerun after
@@ -95,7 +96,7 @@ fault nan "returned a non-finite point (vertex "
 fault ids "no points of the shape (vertex ids or another unit written as coordinates?)"
 
 # ---- the plug-in rebuilt with other code: refused like changed params
-build libcentroid.so -DSHIFT=0.001f
+build libcentroid.so -DSHIFT=0.001f '-DVERSION="1.1"' 
 expect 2 "--force --only centroid" "$tcbench" run mine.json --quiet
 grep -qF "plugin_fnv1a64" err.txt || { echo "FAIL: the refusal does not say the plug-in changed"; cat err.txt; exit 1; }
 grep -qF "cells: 2 in all, 0 computed, 2 already done, 0 failed" err.txt || { cat err.txt; exit 1; }
@@ -108,6 +109,8 @@ expect 0 "cells: 2 in all, 2 computed, 0 already done, 0 failed" "$tcbench" run 
 new=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["plugin"]["fnv1a64"])' \
       "$cells/quadruped_walk/centroid/seed_0.json")
 [ "$old" != "$new" ] || { echo "FAIL: the cell does not record the new build"; exit 1; }
+/usr/bin/python3 -c 'import json,sys; assert json.load(open(sys.argv[1]))["plugin"]["version"] == "1.1"' \
+    "$cells/quadruped_walk/centroid/seed_0.json"
 cell_sums | grep nearest > nearest.txt
 grep nearest before.txt | cmp -s - nearest.txt || { echo "FAIL: the rebuilt plug-in's run touched nearest"; exit 1; }
 expect 0 "cells: 4 in all, 0 computed, 4 already done" "$tcbench" run mine.json --quiet
