@@ -34,7 +34,7 @@ static const char *const objdir_keys[] = {"name", "source", "root", "optional", 
 static const char *const dfaust_keys[] = {"name", "source", "root", "optional", "normalization",
                                           "sampling", "subjects", "sequences", NULL};
 static const char *const sequence_keys[] = {"name", "role", NULL};
-static const char *const method_keys[] = {"name", "method", "params", "seeds", "datasets", NULL};
+static const char *const method_keys[] = {"name", "method", "params", "seeds", "datasets", "plugin_fnv1a64", NULL};
 
 const char *const tcb_config_source_names[] = {"synthetic", "objdir", "dfaust", NULL};
 const char *const tcb_config_norm_names[] = {"none", "first_frame", "per_frame", NULL};
@@ -306,6 +306,19 @@ int tcb_config_find_sequence(const tcb_config *c, const char *dataset, const cha
     return TCB_OK;
 }
 
+/* "plugin_fnv1a64": 16 hex digits, what a run directory's record says of a
+ * plug-in method (harness/run_config.c); optional. */
+static int parse_plugin_digest(const cJSON *o, const char *where, tcb_method_spec *m, tcb_error *err)
+{
+    const char *digest;
+    int rc = tcb_json_str(o, "plugin_fnv1a64", where, 0, "", &digest, err);
+    if (rc || !digest[0]) return rc;
+    if (strlen(digest) != 16 || strspn(digest, "0123456789abcdef") != 16)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.plugin_fnv1a64: expected 16 hex digits, got \"%s\"", where, digest);
+    memcpy(m->plugin_digest, digest, sizeof m->plugin_digest);
+    return TCB_OK;
+}
+
 static int parse_method(const cJSON *o, const char *where, const tcb_config *c,
                         tcb_method_spec *m, tcb_error *err)
 {
@@ -325,6 +338,7 @@ static int parse_method(const cJSON *o, const char *where, const tcb_config *c,
     m->params_json = params ? cJSON_PrintUnformatted(params) : strdup("{}");
     if (!m->params_json) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", where);
     rc = parse_method_seeds(o, where, c, m, err);
+    if (!rc) rc = parse_plugin_digest(o, where, m, err);
     return rc ? rc : parse_method_datasets(o, where, c, m, err);
 }
 

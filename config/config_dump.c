@@ -80,6 +80,7 @@ static cJSON *dump_method(const tcb_method_spec *m, const tcb_config *c)
         cJSON *on = cJSON_AddArrayToObject(o, "datasets");
         for (int k = 0; k < m->n_only_on; k++) cJSON_AddItemToArray(on, cJSON_CreateString(m->only_on[k]));
     }
+    if (m->plugin_digest[0]) cJSON_AddStringToObject(o, "plugin_fnv1a64", m->plugin_digest);
     return o;
 }
 

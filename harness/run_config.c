@@ -275,7 +275,10 @@ static cJSON *record_of(const tcb_config *cfg)
     for (cJSON *m = r ? first(r, "methods") : NULL; m && k < cfg->n_methods; m = m->next, k++) {
         const tcb_method_ops *ops = tcb_registry_find(cfg->methods[k].method);
         const char *digest = ops ? tcb_registry_digest(ops) : NULL;
-        if (digest && !cJSON_AddStringToObject(m, "plugin_fnv1a64", digest)) {
+        if (!digest) continue;
+        /* the build loaded now, over what a config copied from a record says */
+        cJSON_DeleteItemFromObjectCaseSensitive(m, "plugin_fnv1a64");
+        if (!cJSON_AddStringToObject(m, "plugin_fnv1a64", digest)) {
             cJSON_Delete(r);
             return NULL;
         }

@@ -58,6 +58,15 @@ int tcb_cell_target_resolve(const tcb_config *cfg, const char *method, int seed,
     if (!(t->ops = tcb_registry_find(t->m->method)))
         return tcb_fail(err, TCB_ERR_INPUT, "%s: method '%s' is not registered (a plug-in?)",
                         cfg->path, t->m->method);
+    /* Recomputing a cell with another build of its plug-in would compare
+     * other code's numbers with the cell's. */
+    const char *digest = tcb_registry_digest(t->ops);
+    if (t->m->plugin_digest[0] && digest && strcmp(digest, t->m->plugin_digest) != 0)
+        return tcb_fail(err, TCB_ERR_INPUT,
+                        "%s: %s's cells were computed by the build %s of its plug-in, but %s is %s (rebuilt "
+                        "since): recompute them with 'tcbench run CONFIG --force --only %s' first",
+                        cfg->path, t->m->label, t->m->plugin_digest, tcb_registry_file(t->ops), digest,
+                        t->m->label);
     t->seed = seed >= 0 ? seed : t->m->seeds[0];
     for (int k = 0; k < t->m->n_seeds; k++)
         if (t->m->seeds[k] == t->seed) return TCB_OK;

@@ -105,6 +105,8 @@ typedef struct tcb_method_spec {
     int *seeds;
     int n_only_on;           /* "datasets": the datasets it runs on; 0: all of them */
     char (*only_on)[64];
+    char plugin_digest[17];  /* "plugin_fnv1a64": the plug-in build its cells were computed
+                              * with, as a run directory records it; "" when not given */
 } tcb_method_spec;
 
 /* Whether method m has cells on the dataset named `dataset`. */

@@ -401,6 +401,7 @@ CENTROID_FAULT=ids:quadruped_walk row "a transfer off the shape: vertex ids as x
 run plug.json > /dev/null 2>&1
 plugin libcentroid.so -DSHIFT=0.001f
 row "the plug-in rebuilt with other code (its cells there are refused)" run plug.json
+row "\`inspect\` of a cell computed by another build of its plug-in" "$TCBENCH" inspect runs/plug centroid 0 --quiet
 rm -rf runs
 
 # ---- command line

@@ -10,6 +10,7 @@
 #     exactly the failed cell;
 #   - the plug-in rebuilt with other code: its cells are refused like
 #     changed params, naming the fix; `cells` says "(other settings)";
+#     `inspect` refuses to recompute a pair with the other build;
 #     --force --only recomputes them, and the cell records the new build;
 #   - the same file by --plugin and the config's "plugins": loaded once; a
 #     different file with the same method name: refused naming both files;
@@ -103,6 +104,11 @@ grep -qF "cells: 2 in all, 0 computed, 2 already done, 0 failed" err.txt || { ca
 expect 0 "" "$tcbench" cells mine.json
 [ "$(grep -c 'centroid .* done (other settings)$' out.txt)" -eq 2 ] || { echo "FAIL: cells"; cat out.txt; exit 1; }
 [ "$(grep -c 'nearest .* done$' out.txt)" -eq 2 ] || { echo "FAIL: cells"; cat out.txt; exit 1; }
+# inspect would recompute a pair with other code than the cell's: refused
+expect 2 "centroid's cells were computed by the build " \
+    "$tcbench" inspect runs/mine centroid 0 --sequence synth/quadruped_walk --quiet
+grep -qF "(rebuilt since): recompute them with 'tcbench run CONFIG --force --only centroid' first" err.txt ||
+    { cat err.txt; exit 1; }
 old=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["plugin"]["fnv1a64"])' \
       "$cells/quadruped_walk/centroid/seed_0.json")
 expect 0 "cells: 2 in all, 2 computed, 0 already done, 0 failed" "$tcbench" run mine.json --quiet --force --only centroid
@@ -111,6 +117,7 @@ new=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["
 [ "$old" != "$new" ] || { echo "FAIL: the cell does not record the new build"; exit 1; }
 /usr/bin/python3 -c 'import json,sys; assert json.load(open(sys.argv[1]))["plugin"]["version"] == "1.1"' \
     "$cells/quadruped_walk/centroid/seed_0.json"
+expect 0 "" "$tcbench" inspect runs/mine centroid 0 --sequence synth/quadruped_walk --quiet
 cell_sums | grep nearest > nearest.txt
 grep nearest before.txt | cmp -s - nearest.txt || { echo "FAIL: the rebuilt plug-in's run touched nearest"; exit 1; }
 expect 0 "cells: 4 in all, 0 computed, 4 already done" "$tcbench" run mine.json --quiet
