@@ -19,14 +19,14 @@
 #include "tcb/sysinfo.h"
 
 /* Per-pair scratch, sized for the sequence once per cell, the scorer (the
- * edge graph of the faces, for the geodesic error) and the index of every
+ * edge graph of the faces, for the geodesic error) and the box of every
  * frame's vertices a transfer is checked against, also made once. */
 typedef struct eval_bufs {
     float *moved;   /* [nv][3] transfer output on frame j */
     int32_t *pred;  /* [nv] predicted vertex ids of frame j */
     double *geo;    /* [nv] each vertex's normalised geodesic error */
     tcb_pair_scorer scorer;
-    tcb_nn *shape;  /* [n_frames * nv] for tcb_transfer_check */
+    double box[6];  /* tcb_sequence_box, for tcb_transfer_check */
 } eval_bufs;
 
 static void eval_bufs_free(eval_bufs *b)
@@ -35,7 +35,6 @@ static void eval_bufs_free(eval_bufs *b)
     free(b->pred);
     free(b->geo);
     tcb_pair_scorer_free(&b->scorer);
-    tcb_nn_free(b->shape);
     memset(b, 0, sizeof *b);
 }
 
@@ -51,8 +50,8 @@ static int eval_bufs_init(const tcb_sequence *seq, eval_bufs *b, tcb_error *herr
         return tcb_fail(herr, TCB_ERR_NOMEM, "out of memory for %zu vertices", nv);
     }
     int rc = tcb_pair_scorer_init(&b->scorer, seq, herr);
-    if (!rc) rc = tcb_nn_build(seq->verts, seq->n_verts * seq->n_frames, &b->shape, herr);
     if (rc) eval_bufs_free(b);
+    else tcb_sequence_box(seq, b->box);
     return rc;
 }
 
@@ -232,10 +231,10 @@ static void reconstruction_cd(const tcb_cell_job *job, void *self, int i, int j,
 }
 
 /* The method's transfer of frame i's GT vertices to frame j into moved,
- * checked (tcb_transfer_check against the shape index); k numbers the pair
- * in messages. */
+ * checked (tcb_transfer_check against the sequence's box); k numbers the
+ * pair in messages. */
 static int transfer_pair(const tcb_cell_job *job, void *self, int i, int j, int k, tcb_rng *rng,
-                         const tcb_nn *shape, float *moved, tcb_error *merr)
+                         const double box[6], float *moved, tcb_error *merr)
 {
     const tcb_sequence *seq = job->seq;
     int nv = seq->n_verts;
@@ -245,7 +244,7 @@ static int transfer_pair(const tcb_cell_job *job, void *self, int i, int j, int 
         tcb_error_prefix(merr, "transfer %d->%d (pair %d): ", i, j, k);
         return rc;
     }
-    if ((rc = tcb_transfer_check(shape, seq, j, moved, merr)))
+    if ((rc = tcb_transfer_check(box, seq, j, moved, merr)))
         tcb_error_prefix(merr, "transfer %d->%d (pair %d): ", i, j, k);
     return rc;
 }
@@ -263,7 +262,7 @@ static void eval_pair(const tcb_cell_job *job, void *self, int k, eval_bufs *b,
     snprintf(label, sizeof label, "eval/%s/%s/%d", job->dataset->name, seq->name, k);
     tcb_rng rng;
     tcb_rng_seed_stream(&rng, (uint64_t)job->seed, label);
-    if (transfer_pair(job, self, i, j, k, &rng, b->shape, b->moved, merr)) return;
+    if (transfer_pair(job, self, i, j, k, &rng, b->box, b->moved, merr)) return;
     double cd = NAN;
     if (job->ops->reconstruct) {
         double cd_i = 0, cd_j = 0;
@@ -290,7 +289,7 @@ static void eval_pair(const tcb_cell_job *job, void *self, int k, eval_bufs *b,
  * as the method gave them, not projected: DynoSurf scores its predicted
  * vertices) into rec. Each transfer draws from a stream of its own frames,
  * the same whether or not the pairs are evaluated too. */
-static void eval_clip(const tcb_cell_job *job, void *self, int c, int first, const tcb_nn *shape, float *moved,
+static void eval_clip(const tcb_cell_job *job, void *self, int c, int first, const double box[6], float *moved,
                       tcb_clip_record *rec, tcb_error *merr)
 {
     const tcb_sequence *seq = job->seq;
@@ -302,7 +301,7 @@ static void eval_clip(const tcb_cell_job *job, void *self, int c, int first, con
         snprintf(label, sizeof label, "clip/%s/%s/%d/%d", job->dataset->name, seq->name, s, t);
         tcb_rng rng;
         tcb_rng_seed_stream(&rng, (uint64_t)job->seed, label);
-        if (transfer_pair(job, self, s, s + t, first + t - 1, &rng, shape, moved, merr)) return;
+        if (transfer_pair(job, self, s, s + t, first + t - 1, &rng, box, moved, merr)) return;
         rec->err[t - 1] = tcb_corr_frame(moved, tcb_seq_frame(seq, s + t), seq->n_verts);
         rec->corr += rec->err[t - 1] / CLIP_PAIRS;
     }
@@ -351,7 +350,7 @@ static void evaluate_clips(const tcb_cell_job *job, void *self, eval_bufs *b, tc
     for (int k = 0; k < clips->n_clips && !merr->code; k++) {
         int done = first + k * CLIP_PAIRS;
         if (stop_requested(job, done, total, herr)) return;
-        eval_clip(job, self, k, done, b->shape, b->moved, &c->clips[k], merr);
+        eval_clip(job, self, k, done, b->box, b->moved, &c->clips[k], merr);
         tcb_stat_push(&c->summary.corr, c->clips[k].corr);
         tcb_report_progress(&job->reporter, done + CLIP_PAIRS, total, label);
     }

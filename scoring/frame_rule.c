@@ -75,29 +75,11 @@ int tcb_frame_fit_measure(const tcb_nn *shape, const float *verts_j, int nv, con
     int rc = !q || !dist2 || !idx ? tcb_fail(err, TCB_ERR_NOMEM, "out of memory for %d points", n) : TCB_OK;
     if (!rc) rc = median_fit(shape, points, n, dist2, idx, &f->fit, err);
     f->fit_raw = INFINITY;
-    if (!rc && shift && normalised(points, n, shift, scale, q)) rc = median_fit(shape, q, n, dist2, idx, &f->fit_raw, err);
+    if (!rc && normalised(points, n, shift, scale, q)) rc = median_fit(shape, q, n, dist2, idx, &f->fit_raw, err);
     free(q);
     free(dist2);
     free(idx);
     return rc;
-}
-
-/* The far clause, for both checks. */
-static int far_from_shape(const tcb_frame_fit *f, tcb_error *err)
-{
-    if (f->fit <= TCB_FRAME_FAR * f->diag) return TCB_OK;
-    return tcb_fail(err, TCB_ERR_INPUT,
-                    "the points lie a median %.3g box diagonals from the sequence's vertices (more than %g): "
-                    "no points of the shape (vertex ids or another unit written as coordinates?)",
-                    f->fit / f->diag, TCB_FRAME_FAR);
-}
-
-int tcb_score_check_shape(const tcb_nn *shape, const float *verts_j, int nv, const float *points, int n,
-                          tcb_error *err)
-{
-    tcb_frame_fit f;
-    int rc = tcb_frame_fit_measure(shape, verts_j, nv, points, n, NULL, 1, &f, err);
-    return rc ? rc : far_from_shape(&f, err);
 }
 
 int tcb_score_check_frame(const tcb_nn *shape, const float *verts_j, int nv, const float *points, int n,
@@ -105,7 +87,12 @@ int tcb_score_check_frame(const tcb_nn *shape, const float *verts_j, int nv, con
 {
     tcb_frame_fit f;
     int rc = tcb_frame_fit_measure(shape, verts_j, nv, points, n, shift, scale, &f, err);
-    if (rc || (rc = far_from_shape(&f, err))) return rc;
+    if (rc) return rc;
+    if (f.fit > TCB_FRAME_FAR * f.diag)
+        return tcb_fail(err, TCB_ERR_INPUT,
+                        "the points lie a median %.3g box diagonals from the sequence's vertices (more than %g): "
+                        "no points of the shape (vertex ids or another unit written as coordinates?)",
+                        f.fit / f.diag, TCB_FRAME_FAR);
     if (f.fit > TCB_FRAME_RAW_RATIO * f.fit_raw && f.fit > TCB_FRAME_RAW_MIN * f.diag)
         return tcb_fail(err, TCB_ERR_INPUT,
                         "the points lie a median %.3g box diagonals from the sequence's vertices, %.3g once "

@@ -13,7 +13,6 @@
 #include "tcb/geodesic.h"
 #include "tcb/method.h"
 #include "tcb/metrics.h"
-#include "tcb/nn.h"
 #include "tcb/results.h"
 
 /* What tcb/method.h promises of a method's surface of `frame` (at most
@@ -24,13 +23,15 @@ int tcb_surface_check(const tcb_uv_mesh *m, int frame, int max_charts, tcb_error
 /* What tcb/method.h promises of a transfer (frame i's vertices carried
  * onto frame j, moved[n_verts][3]), checked before anything scores it:
  * every coordinate finite and within ±TCB_NN_COORD_MAX (what the k-NN
- * search takes), and the points on the shape (the far clause of the
- * wrong-frame rule, tcb_score_check_shape, against `shape`, an index of
- * every frame's vertices; the raw-coordinate clause is for files: a
- * method is given normalised frames). A violation is TCB_ERR_INPUT in
- * merr, naming the vertex or giving the median: the method's output is
- * wrong, and its cell fails (scoring/transfer_check.c). */
-int tcb_transfer_check(const tcb_nn *shape, const tcb_sequence *seq, int j, const float *moved, tcb_error *merr);
+ * search takes), and the points not a median TCB_FRAME_FAR diagonals of
+ * frame j's box outside `box`, the box of every frame's vertices
+ * (tcb_sequence_box: [lo xyz, hi xyz]; the wrong-frame rule's far clause;
+ * its raw-coordinate clause is for files: a method is given normalised
+ * frames). A violation is TCB_ERR_INPUT in merr, naming the vertex or
+ * giving the median: the method's output is wrong, and its cell fails
+ * (scoring/transfer_check.c). */
+void tcb_sequence_box(const tcb_sequence *seq, double box[6]);
+int tcb_transfer_check(const double box[6], const tcb_sequence *seq, int j, const float *moved, tcb_error *merr);
 
 /* One evaluation pair's prediction: a method's transfer, or what `tcbench
  * score` read from a file. */

@@ -56,7 +56,13 @@ void tcb_predictions_close(tcb_predictions *p);
  * no points of the shape at all (vertex ids written as x lie hundreds of
  * diagonals away, a unit a thousand times off likewise). A diverged
  * method's points, blown up tenfold, stay within a few: they are scored,
- * as the bad result they are. */
+ * as the bad result they are. A method's transfer is held to this clause
+ * alone, measured to the box of every frame (scoring/scoring.h,
+ * tcb_transfer_check): it is computed on the frames the harness
+ * normalised, and the raw clause is no test for it (a barely trained
+ * network's points, 1 % of a diagonal off the shape, came 2.4 times
+ * closer once normalised a second time on a synthetic sequence, whose
+ * normalisation is a small shift). */
 #define TCB_FRAME_FAR 100.0
 typedef struct tcb_frame_fit {
     double diag;          /* D */
@@ -66,15 +72,6 @@ int tcb_frame_fit_measure(const tcb_nn *shape, const float *verts_j, int nv, con
                           const double shift[3], double scale, tcb_frame_fit *f, tcb_error *err);
 int tcb_score_check_frame(const tcb_nn *shape, const float *verts_j, int nv, const float *points, int n,
                           const double shift[3], double scale, tcb_error *err);
-/* The far clause alone (fit > TCB_FRAME_FAR * D), for points that cannot
- * be in raw coordinates: a method's transfer, computed on the frames the
- * harness normalised. (The raw clause is no test for those: a barely
- * trained network's points, 1 % of a diagonal off the shape, came 2.4
- * times closer once normalised a second time on a synthetic sequence,
- * whose normalisation is a small shift.) measure with shift NULL skips
- * fit_raw (INFINITY). */
-int tcb_score_check_shape(const tcb_nn *shape, const float *verts_j, int nv, const float *points, int n,
-                          tcb_error *err);
 
 /* The readers `tcbench score` and the external method (whose command
  * writes these files) share (scoring/prediction_files.c); errors name the file.
