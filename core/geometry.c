@@ -29,6 +29,23 @@ int tcb_all_finite_d(const double *x, size_t n)
     return 1;
 }
 
+void tcb_bbox(const float *points, size_t n, double box[6])
+{
+    for (int d = 0; d < 3; d++) box[d] = INFINITY, box[3 + d] = -INFINITY;
+    for (size_t k = 0; k < n; k++)
+        for (int d = 0; d < 3; d++) {
+            double x = points[3 * k + d];
+            box[d] = fmin(box[d], x), box[3 + d] = fmax(box[3 + d], x);
+        }
+}
+
+double tcb_bbox_diag(const double box[6])
+{
+    double d2 = 0;
+    for (int d = 0; d < 3; d++) d2 += (box[3 + d] - box[d]) * (box[3 + d] - box[d]);
+    return sqrt(d2);
+}
+
 double tcb_triangle_area(const float *a, const float *b, const float *c)
 {
     double n[3];

@@ -26,7 +26,7 @@ typedef struct eval_bufs {
     int32_t *pred;  /* [nv] predicted vertex ids of frame j */
     double *geo;    /* [nv] each vertex's normalised geodesic error */
     tcb_pair_scorer scorer;
-    double box[6];  /* tcb_sequence_box, for tcb_transfer_check */
+    double box[6];  /* every frame's vertices' (tcb_bbox), for tcb_transfer_check */
 } eval_bufs;
 
 static void eval_bufs_free(eval_bufs *b)
@@ -51,7 +51,7 @@ static int eval_bufs_init(const tcb_sequence *seq, eval_bufs *b, tcb_error *herr
     }
     int rc = tcb_pair_scorer_init(&b->scorer, seq, herr);
     if (rc) eval_bufs_free(b);
-    else tcb_sequence_box(seq, b->box);
+    else tcb_bbox(seq->verts, (size_t)seq->n_frames * nv, b->box);
     return rc;
 }
 

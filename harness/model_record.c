@@ -42,24 +42,13 @@ static void identity_of(const tcb_cell_job *job, identity *id)
     snprintf(id->sequence, sizeof id->sequence, "%016" PRIx64, tcb_sequence_fingerprint(job->seq));
 }
 
-/* The size and FNV-1a of a file, the hash as 16 hex digits. */
-static int file_digest(const char *path, size_t *bytes, char hex[17], tcb_error *err)
-{
-    char *data;
-    int rc = tcb_read_file(path, &data, bytes, err);
-    if (rc) return rc;
-    snprintf(hex, 17, "%016" PRIx64, tcb_fnv1a64(TCB_FNV1A64_OFFSET, data, *bytes));
-    free(data);
-    return TCB_OK;
-}
-
 int tcb_model_record_save(const tcb_cell_job *job, const char *saved, double fit_s, tcb_error *err)
 {
     char path[TCB_PATH_MAX], hex[17];
     size_t bytes;
     identity id;
     int rc = record_path(job->checkpoint, path, err);
-    if (!rc) rc = file_digest(saved, &bytes, hex, err);
+    if (!rc) rc = tcb_file_fnv1a64(saved, &bytes, hex, err);
     if (rc) return rc;
     identity_of(job, &id);
     cJSON *o = cJSON_CreateObject();
@@ -104,7 +93,7 @@ int tcb_model_record_check(const tcb_cell_job *job, double *fit_s, tcb_error *er
     if (!rc) rc = tcb_json_num(o, "bytes", path, 1, 0, 0, 1e18, &want_bytes, err);
     if (!rc) rc = tcb_json_str(o, "fnv1a64", path, 1, NULL, &want_hex, err);
     if (!rc) rc = tcb_json_num(o, "fit_s", path, 1, 0, 0, INFINITY, fit_s, err);
-    if (!rc) rc = file_digest(job->checkpoint, &bytes, hex, err);
+    if (!rc) rc = tcb_file_fnv1a64(job->checkpoint, &bytes, hex, err);
     if (!rc && (double)bytes != want_bytes)
         rc = tcb_fail(err, TCB_ERR_INPUT, "%s: %zu bytes, its record %s says %.0f (truncated or replaced)",
                       job->checkpoint, bytes, path, want_bytes);

@@ -6,14 +6,12 @@
 
 #include <dlfcn.h>
 #include <errno.h>
-#include <inttypes.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "methods/builtin.h"
-#include "tcb/fsutil.h"
 #include "tcb/hash.h"
 #include "tcb/version.h"
 
@@ -119,18 +117,6 @@ static int check_table(const tcb_method_ops *ops, const char *path, tcb_error *e
     return TCB_OK;
 }
 
-/* FNV-1a 64 of the file at path, as 16 hex digits. */
-static int file_digest(const char *path, char hex[17], tcb_error *err)
-{
-    char *data;
-    size_t n;
-    int rc = tcb_read_file(path, &data, &n, err);
-    if (rc) return rc;
-    snprintf(hex, 17, "%016" PRIx64, tcb_fnv1a64(TCB_FNV1A64_OFFSET, data, n));
-    free(data);
-    return TCB_OK;
-}
-
 int tcb_registry_load_plugin(const char *path, tcb_error *err)
 {
     /* One file is one plug-in however it is named (--plugin and a config's
@@ -140,7 +126,7 @@ int tcb_registry_load_plugin(const char *path, tcb_error *err)
     for (int k = 0; k < n_plugins; k++)
         if (strcmp(plugins[k].origin, full) == 0) return TCB_OK; /* already loaded */
     char digest[17];
-    int rc = file_digest(full, digest, err);
+    int rc = tcb_file_fnv1a64(full, NULL, digest, err);
     if (rc) return rc;
     void *handle = dlopen(full, RTLD_NOW | RTLD_LOCAL);
     if (!handle) return tcb_fail(err, TCB_ERR_INPUT, "%s: cannot load plug-in: %s", path, dlerror());

@@ -31,6 +31,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "tcb/geometry.h"
 #include "tcb/nn.h"
 #include "tcb/predictions.h"
 
@@ -65,11 +66,9 @@ static int normalised(const float *p, int n, const double shift[3], double scale
 int tcb_frame_fit_measure(const tcb_nn *shape, const float *verts_j, int nv, const float *points, int n,
                           const double shift[3], double scale, tcb_frame_fit *f, tcb_error *err)
 {
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, d2 = 0;
-    for (int k = 0; k < nv; k++)
-        for (int d = 0; d < 3; d++) lo[d] = fmin(lo[d], verts_j[3 * k + d]), hi[d] = fmax(hi[d], verts_j[3 * k + d]);
-    for (int d = 0; d < 3; d++) d2 += (hi[d] - lo[d]) * (hi[d] - lo[d]);
-    f->diag = sqrt(d2);
+    double box[6];
+    tcb_bbox(verts_j, (size_t)nv, box);
+    f->diag = tcb_bbox_diag(box);
     float *q = malloc((size_t)n * 3 * sizeof *q), *dist2 = malloc((size_t)n * sizeof *dist2);
     int32_t *idx = malloc((size_t)n * sizeof *idx);
     int rc = !q || !dist2 || !idx ? tcb_fail(err, TCB_ERR_NOMEM, "out of memory for %d points", n) : TCB_OK;

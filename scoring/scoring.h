@@ -25,12 +25,11 @@ int tcb_surface_check(const tcb_uv_mesh *m, int frame, int max_charts, tcb_error
  * every coordinate finite and within ±TCB_NN_COORD_MAX (what the k-NN
  * search takes), and the points not a median TCB_FRAME_FAR diagonals of
  * frame j's box outside `box`, the box of every frame's vertices
- * (tcb_sequence_box: [lo xyz, hi xyz]; the wrong-frame rule's far clause;
+ * (tcb_bbox of seq->verts; the wrong-frame rule's far clause;
  * its raw-coordinate clause is for files: a method is given normalised
  * frames). A violation is TCB_ERR_INPUT in merr, naming the vertex or
  * giving the median: the method's output is wrong, and its cell fails
  * (scoring/transfer_check.c). */
-void tcb_sequence_box(const tcb_sequence *seq, double box[6]);
 int tcb_transfer_check(const double box[6], const tcb_sequence *seq, int j, const float *moved, tcb_error *merr);
 
 /* One evaluation pair's prediction: a method's transfer, or what `tcbench

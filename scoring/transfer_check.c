@@ -13,34 +13,13 @@
 #include <stdlib.h>
 
 #include "scoring/scoring.h"
+#include "tcb/geometry.h"
 #include "tcb/predictions.h"
-
-void tcb_sequence_box(const tcb_sequence *seq, double box[6])
-{
-    for (int d = 0; d < 3; d++) box[d] = INFINITY, box[3 + d] = -INFINITY;
-    size_t n = (size_t)seq->n_frames * seq->n_verts;
-    for (size_t k = 0; k < n; k++)
-        for (int d = 0; d < 3; d++) {
-            double x = seq->verts[3 * k + d];
-            box[d] = fmin(box[d], x), box[3 + d] = fmax(box[3 + d], x);
-        }
-}
 
 static int by_value(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
     return (x > y) - (x < y);
-}
-
-/* The diagonal of frame j's bounding box: D of the wrong-frame rule. */
-static double frame_diag(const tcb_sequence *seq, int j)
-{
-    const float *v = tcb_seq_frame(seq, j);
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, d2 = 0;
-    for (int k = 0; k < seq->n_verts; k++)
-        for (int d = 0; d < 3; d++) lo[d] = fmin(lo[d], v[3 * k + d]), hi[d] = fmax(hi[d], v[3 * k + d]);
-    for (int d = 0; d < 3; d++) d2 += (hi[d] - lo[d]) * (hi[d] - lo[d]);
-    return sqrt(d2);
 }
 
 /* The median distance from the points to the box. */
@@ -74,7 +53,9 @@ int tcb_transfer_check(const double box[6], const tcb_sequence *seq, int j, cons
             return tcb_fail(merr, TCB_ERR_INPUT, "returned a point beyond ±%g (vertex %d: %g %g %g)",
                             (double)TCB_NN_COORD_MAX, v, p[0], p[1], p[2]);
     }
-    double median = 0, diag = frame_diag(seq, j);
+    double frame_box[6], median = 0;
+    tcb_bbox(tcb_seq_frame(seq, j), (size_t)nv, frame_box);
+    double diag = tcb_bbox_diag(frame_box); /* D of the wrong-frame rule */
     int rc = median_box_distance(box, moved, nv, &median, merr);
     if (rc || median <= TCB_FRAME_FAR * diag) return rc;
     return tcb_fail(merr, TCB_ERR_INPUT,

@@ -19,6 +19,11 @@ int tcb_all_finite_d(const double *x, size_t n);
 
 double tcb_triangle_area(const float *a, const float *b, const float *c);
 
+/* The axis-aligned box of n points [n][3]: box = [lo xyz, hi xyz]; and its
+ * diagonal. */
+void tcb_bbox(const float *points, size_t n, double box[6]);
+double tcb_bbox_diag(const double box[6]);
+
 /* Sum of triangle areas; faces are [nf][3] vertex ids. */
 double tcb_mesh_area(const float *verts, const int32_t *faces, int nf);
 

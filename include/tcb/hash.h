@@ -7,6 +7,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "tcb/error.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -14,6 +16,11 @@ extern "C" {
 #define TCB_FNV1A64_OFFSET 0xcbf29ce484222325ULL
 
 uint64_t tcb_fnv1a64(uint64_t h, const void *data, size_t len);
+
+/* The FNV-1a 64 of the file at path as 16 hex digits (hex[17]), and its
+ * size in *bytes (may be NULL): how a model checkpoint's record and a
+ * plug-in's build name a file's contents. */
+int tcb_file_fnv1a64(const char *path, size_t *bytes, char hex[17], tcb_error *err);
 
 #ifdef __cplusplus
 }

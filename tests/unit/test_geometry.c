@@ -175,10 +175,23 @@ static void test_sampling_zero_area_fails(void **state)
     assert_non_null(strstr(err.msg, "area"));
 }
 
+/* The box of a 3 x 4 x 12 cuboid's corners and a point inside: diagonal 13. */
+static void test_bbox(void **state)
+{
+    (void)state;
+    const float pts[] = {1, -2, 5, 4, 2, -7, 2, 0, 0, 1, 2, 5};
+    double box[6];
+    tcb_bbox(pts, 4, box);
+    const double want[6] = {1, -2, -7, 4, 2, 5};
+    for (int k = 0; k < 6; k++) assert_float_equal(box[k], want[k], 0);
+    assert_float_equal(tcb_bbox_diag(box), 13.0, 1e-12);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_triangle_area),
+        cmocka_unit_test(test_bbox),
         cmocka_unit_test(test_mesh_area),
         cmocka_unit_test(test_surface_centroid),
         cmocka_unit_test(test_normals_tetra),
