@@ -21,8 +21,9 @@ static const char *const top_keys[] = {"name", "output", "splits_dir", "cache_di
                                        "seeds", "threads", "evaluation", "datasets", "methods",
                                        "reference", NULL};
 static const char *const reference_keys[] = {"source", "tables", NULL};
-static const char *const eval_keys[] = {"pairs", "split_seed", "pool_size", "pool_seed",
-                                        "input_points", "protocol", "clips", "surface_samples", NULL};
+static const char *const eval_keys[] = {"pairs", "split_seed", "pool_size", "pool_seed", "input_points",
+                                        "protocol", "clips", "fit", "input_normals", "recon_frame",
+                                        "surface_samples", NULL};
 /* Indexed by the bit's position: TCB_PROTOCOL_PAIRS, TCB_PROTOCOL_CLIPS. */
 const char *const tcb_config_protocol_names[] = {"pairs", "clips", NULL};
 static const char *const synthetic_keys[] = {"name", "source", "seed", "frames", "normalization",
@@ -33,11 +34,13 @@ static const char *const objdir_keys[] = {"name", "source", "root", "optional", 
  * across the subjects' blocks would be meaningless, and DFAUST has none. */
 static const char *const dfaust_keys[] = {"name", "source", "root", "optional", "normalization",
                                           "sampling", "subjects", "sequences", NULL};
-static const char *const sequence_keys[] = {"name", "role", NULL};
+static const char *const sequence_keys[] = {"name", "role", "clip_starts", "clip_of", "start", NULL};
 static const char *const method_keys[] = {"name", "method", "params", "seeds", "datasets", "plugin_fnv1a64", NULL};
 
 const char *const tcb_config_source_names[] = {"synthetic", "objdir", "dfaust", NULL};
-const char *const tcb_config_norm_names[] = {"none", "first_frame", "per_frame", NULL};
+const char *const tcb_config_norm_names[] = {"none", "first_frame", "per_frame", "clip_bbox", "first_frame_diag", NULL};
+const char *const tcb_config_fit_names[] = {"sequence", "per_clip", NULL};
+const char *const tcb_config_input_normals_names[] = {"none", "gt", "estimated", NULL};
 const char *const tcb_config_sampling_names[] = {"without_replacement", "with_replacement", NULL};
 
 /* The json helpers join `where` and a key with '.', which at the top level
@@ -95,21 +98,9 @@ static int get_array(const cJSON *obj, const char *key, const char *where, int r
     return TCB_OK;
 }
 
-static int parse_sequence(const cJSON *o, const char *where, const tcb_dataset_spec *d,
-                          tcb_sequence_spec *s, tcb_error *err)
+/* A synthetic dataset's sequences are the generator's. */
+static int check_synthetic(const char *name, const char *where, const char *key, tcb_error *err)
 {
-    const char *name, *role;
-    int rc = tcb_json_expect_keys(o, where, sequence_keys, err);
-    if (!rc) rc = tcb_json_str(o, "name", where, 1, NULL, &name, err);
-    if (!rc) rc = check_name(name, sizeof s->name, where, "name", err);
-    if (!rc) rc = tcb_json_str(o, "role", where, 1, NULL, &role, err);
-    if (rc) return rc;
-    if (tcb_role_parse(role, &s->role) != 0)
-        return tcb_fail(err, TCB_ERR_INPUT,
-                        "%s.role: unknown role '%s' (expected train, validation or test)", where,
-                        role);
-    snprintf(s->name, sizeof s->name, "%s", name);
-    if (d->source != TCB_SOURCE_SYNTHETIC) return TCB_OK;
     for (int k = 0; k < tcb_synth_count(); k++)
         if (strcmp(tcb_synth_name(k), name) == 0) return TCB_OK;
     char list[512] = "";
@@ -117,35 +108,120 @@ static int parse_sequence(const cJSON *o, const char *where, const tcb_dataset_s
         size_t used = strlen(list);
         snprintf(list + used, sizeof list - used, "%s%s", k ? ", " : "", tcb_synth_name(k));
     }
-    return tcb_fail(err, TCB_ERR_INPUT, "%s.name: unknown synthetic sequence '%s' (expected %s)",
-                    where, name, list);
+    return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: unknown synthetic sequence '%s' (expected %s)", where, key, name,
+                    list);
 }
 
-static int parse_sequences(const cJSON *o, const char *where, tcb_dataset_spec *d,
+/* How many sequences entry o stands for: its "clip_starts", else one. */
+static int entry_count(const cJSON *o)
+{
+    const cJSON *starts = cJSON_IsObject(o) ? cJSON_GetObjectItemCaseSensitive(o, "clip_starts") : NULL;
+    return cJSON_IsArray(starts) && cJSON_GetArraySize(starts) > 0 ? cJSON_GetArraySize(starts) : 1;
+}
+
+/* "clip_starts": the entry's clips, each a sequence "<name>_<start as %04d>". */
+static int expand_clip_starts(const cJSON *starts, const char *where, const tcb_sequence_spec *base,
+                              tcb_sequence_spec *out, tcb_error *err)
+{
+    int n = cJSON_GetArraySize(starts);
+    if (!cJSON_IsArray(starts) || n == 0)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.clip_starts: expected a non-empty list of first frames", where);
+    for (int k = 0; k < n; k++) {
+        const cJSON *v = cJSON_GetArrayItem(starts, k);
+        double x = cJSON_IsNumber(v) ? v->valuedouble : -1;
+        if (x < 0 || x > 100000000 || x != floor(x))
+            return tcb_fail(err, TCB_ERR_INPUT, "%s.clip_starts[%d]: expected a frame number >= 0", where, k);
+        out[k] = *base;
+        snprintf(out[k].clip_of, sizeof out[k].clip_of, "%s", base->name);
+        out[k].start = (int)x;
+        int len = snprintf(out[k].name, sizeof out[k].name, "%s_%04d", base->name, out[k].start);
+        if (len >= (int)sizeof out[k].name)
+            return tcb_fail(err, TCB_ERR_INPUT, "%s.clip_starts[%d]: the clip's name %s_%04d is too long", where, k,
+                            base->name, out[k].start);
+    }
+    return TCB_OK;
+}
+
+/* "clip_of" and "start": one clip, as a run directory records it. */
+static int parse_clip_of(const cJSON *o, const char *where, tcb_sequence_spec *s, tcb_error *err)
+{
+    const char *of;
+    long long start;
+    int rc = tcb_json_str(o, "clip_of", where, 1, NULL, &of, err);
+    if (!rc) rc = check_name(of, sizeof s->clip_of, where, "clip_of", err);
+    if (!rc) rc = tcb_json_int(o, "start", where, 1, 0, 0, 100000000, &start, err);
+    if (rc) return rc;
+    snprintf(s->clip_of, sizeof s->clip_of, "%s", of);
+    s->start = (int)start;
+    return TCB_OK;
+}
+
+/* One entry of "sequences" into out[0 .. entry_count(o)). */
+static int parse_sequence(const cJSON *o, const char *where, const tcb_dataset_spec *d, int per_clip,
+                          tcb_sequence_spec *out, tcb_error *err)
+{
+    const char *name, *role;
+    int rc = tcb_json_expect_keys(o, where, sequence_keys, err);
+    if (!rc) rc = tcb_json_str(o, "name", where, 1, NULL, &name, err);
+    if (!rc) rc = check_name(name, sizeof out->name, where, "name", err);
+    if (!rc) rc = tcb_json_str(o, "role", where, 1, NULL, &role, err);
+    if (rc) return rc;
+    if (tcb_role_parse(role, &out->role) != 0)
+        return tcb_fail(err, TCB_ERR_INPUT,
+                        "%s.role: unknown role '%s' (expected train, validation or test)", where,
+                        role);
+    snprintf(out->name, sizeof out->name, "%s", name);
+    const cJSON *starts = cJSON_GetObjectItemCaseSensitive(o, "clip_starts");
+    int clip_of = cJSON_HasObjectItem(o, "clip_of") || cJSON_HasObjectItem(o, "start");
+    const char *clip_key = starts ? "clip_starts" : clip_of ? "clip_of" : NULL;
+    if (clip_key && !per_clip)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: clips of a sequence are fitted on their own only under "
+                        "\"evaluation\": {\"fit\": \"per_clip\"}", where, clip_key);
+    if (starts && clip_of)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: give either clip_starts or clip_of and start, not both", where);
+    if (starts) {
+        tcb_sequence_spec base = *out;
+        rc = expand_clip_starts(starts, where, &base, out, err);
+    }
+    if (clip_of) rc = parse_clip_of(o, where, out, err);
+    if (rc || d->source != TCB_SOURCE_SYNTHETIC) return rc;
+    return clip_of ? check_synthetic(out->clip_of, where, "clip_of", err)
+                   : check_synthetic(name, where, "name", err);
+}
+
+static int parse_sequences(const cJSON *o, const char *where, int per_clip, tcb_dataset_spec *d,
                            tcb_error *err)
 {
     const cJSON *arr;
     int rc = get_array(o, "sequences", where, 1, &arr, err);
     if (rc) return rc;
-    int n = cJSON_GetArraySize(arr);
+    int n = cJSON_GetArraySize(arr), total = 0;
     if (n == 0)
         return tcb_fail(err, TCB_ERR_INPUT, "%s.sequences: must list at least one sequence",
                         where);
-    d->sequences = calloc((size_t)n, sizeof *d->sequences);
-    if (!d->sequences) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", where);
-    char sw[WHERE_MAX + 32]; /* where + ".sequences[k]" */
-    for (int k = 0; k < n; k++) {
-        snprintf(sw, sizeof sw, "%s.sequences[%d]", where, k);
-        rc = parse_sequence(cJSON_GetArrayItem(arr, k), sw, d, &d->sequences[k], err);
-        if (rc) return rc;
-        d->n_sequences = k + 1;
-        for (int m = 0; m < k; m++)
-            if (strcmp(d->sequences[m].name, d->sequences[k].name) == 0)
-                return tcb_fail(err, TCB_ERR_INPUT,
-                                "%s.name: duplicate sequence '%s' (also %s.sequences[%d])", sw,
-                                d->sequences[k].name, where, m);
+    for (int k = 0; k < n; k++) total += entry_count(cJSON_GetArrayItem(arr, k));
+    d->sequences = calloc((size_t)total, sizeof *d->sequences);
+    int *entry_of = malloc((size_t)total * sizeof *entry_of); /* each sequence's entry, for messages */
+    if (!d->sequences || !entry_of) {
+        free(entry_of);
+        return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", where);
     }
-    return TCB_OK;
+    char sw[WHERE_MAX + 32]; /* where + ".sequences[k]" */
+    for (int k = 0; k < n && !rc; k++) {
+        const cJSON *e = cJSON_GetArrayItem(arr, k);
+        snprintf(sw, sizeof sw, "%s.sequences[%d]", where, k);
+        tcb_sequence_spec *first = &d->sequences[d->n_sequences];
+        rc = parse_sequence(e, sw, d, per_clip, first, err);
+        for (int c = 0; !rc && c < entry_count(e); c++, d->n_sequences++) {
+            entry_of[d->n_sequences] = k;
+            for (int m = 0; !rc && m < d->n_sequences; m++)
+                if (strcmp(d->sequences[m].name, first[c].name) == 0)
+                    rc = tcb_fail(err, TCB_ERR_INPUT, "%s.%s: duplicate sequence '%s' (also %s.sequences[%d])", sw,
+                                  first[c].clip_of[0] ? "clip_starts" : "name", first[c].name, where, entry_of[m]);
+        }
+    }
+    free(entry_of);
+    return rc;
 }
 
 /* dfaust "subjects": distinct ids, each a valid name (they key datasets). */
@@ -177,7 +253,7 @@ static int parse_subjects(const cJSON *o, const char *where, tcb_dataset_spec *d
     return TCB_OK;
 }
 
-static int parse_dataset(const cJSON *o, const char *where, tcb_dataset_spec *d, tcb_error *err)
+static int parse_dataset(const cJSON *o, const char *where, int per_clip, tcb_dataset_spec *d, tcb_error *err)
 {
     const char *name, *root;
     int source, norm, sampling;
@@ -210,7 +286,7 @@ static int parse_dataset(const cJSON *o, const char *where, tcb_dataset_spec *d,
     d->norm = (tcb_normalization)norm;
     d->with_replacement = sampling == 1;
     d->align_samples = d->align_rotation ? (int)align_samples : 0;
-    return parse_sequences(o, where, d, err);
+    return parse_sequences(o, where, per_clip, d, err);
 }
 
 /* The distinct non-negative seeds of `arr`; `where` names the list
@@ -357,7 +433,7 @@ static int parse_datasets(const cJSON *root, const char *origin, tcb_config *c, 
     if (!c->datasets) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", origin);
     for (int k = 0; k < n; k++) {
         snprintf(w, sizeof w, "%s: datasets[%d]", origin, k);
-        rc = parse_dataset(cJSON_GetArrayItem(arr, k), w, &c->datasets[k], err);
+        rc = parse_dataset(cJSON_GetArrayItem(arr, k), w, c->fit_per_clip, &c->datasets[k], err);
         c->n_datasets = k + 1; /* so tcb_config_free releases its sequences */
         if (rc) return rc;
         for (int m = 0; m < k; m++)
@@ -484,6 +560,13 @@ static int parse_evaluation(const cJSON *root, const char *origin, tcb_config *c
                           &input, err);
     if (!rc)
         rc = tcb_json_int(ev, "surface_samples", w, 0, TCB_DEFAULT_SURFACE_SAMPLES, 1, 10000000, &surface, err);
+    int normals = 0, recon_frame = 0;
+    if (!rc) rc = tcb_json_enum(ev, "fit", w, 0, 0, tcb_config_fit_names, &c->fit_per_clip, err);
+    if (!rc) rc = tcb_json_enum(ev, "input_normals", w, 0, 0, tcb_config_input_normals_names, &normals, err);
+    if (!rc) rc = tcb_json_enum(ev, "recon_frame", w, 0, 0, tcb_recon_frame_names, &recon_frame, err);
+    /* A clip fitted alone has no frames outside it for pairs to reach. */
+    if (!rc && c->fit_per_clip && c->protocols != TCB_PROTOCOL_CLIPS)
+        rc = tcb_fail(err, TCB_ERR_INPUT, "%s.fit: per_clip needs \"protocol\": \"clips\" alone", w);
     cJSON_Delete(empty);
     if (rc) return rc;
     c->eval_pairs = (int)pairs;
@@ -493,6 +576,8 @@ static int parse_evaluation(const cJSON *root, const char *origin, tcb_config *c
     c->pool_seed = (uint64_t)pool_seed;
     c->input_points = (int)input;
     c->surface_samples = (int)surface;
+    c->input_normals = (tcb_input_normals)normals;
+    c->recon_frame = (tcb_recon_frame)recon_frame;
     return TCB_OK;
 }
 

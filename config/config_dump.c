@@ -17,6 +17,10 @@ static cJSON *dump_evaluation(const tcb_config *c)
     /* Only when not the default, as the protocol below. */
     if (c->surface_samples != TCB_DEFAULT_SURFACE_SAMPLES)
         cJSON_AddNumberToObject(ev, "surface_samples", c->surface_samples);
+    if (c->recon_frame != TCB_RECON_FRAME_SEQUENCE)
+        cJSON_AddStringToObject(ev, "recon_frame", tcb_recon_frame_names[c->recon_frame]);
+    if (c->input_normals != TCB_INPUT_NORMALS_NONE)
+        cJSON_AddStringToObject(ev, "input_normals", tcb_config_input_normals_names[c->input_normals]);
     /* Only when not the default, so that the record of a run directory made
      * before the clip protocol still reads as the same settings. */
     if (c->protocols == TCB_PROTOCOL_PAIRS) return ev;
@@ -25,6 +29,7 @@ static cJSON *dump_evaluation(const tcb_config *c)
     else
         cJSON_AddItemToObject(ev, "protocol", cJSON_CreateStringArray(tcb_config_protocol_names, 2));
     cJSON_AddNumberToObject(ev, "clips", c->eval_clips);
+    if (c->fit_per_clip) cJSON_AddStringToObject(ev, "fit", tcb_config_fit_names[1]);
     return ev;
 }
 
@@ -54,6 +59,10 @@ static cJSON *dump_dataset(const tcb_dataset_spec *d)
         cJSON *s = cJSON_CreateObject();
         cJSON_AddStringToObject(s, "name", d->sequences[k].name);
         cJSON_AddStringToObject(s, "role", tcb_role_name(d->sequences[k].role));
+        if (d->sequences[k].clip_of[0]) { /* the clip_starts of the config, one clip an entry */
+            cJSON_AddStringToObject(s, "clip_of", d->sequences[k].clip_of);
+            cJSON_AddNumberToObject(s, "start", d->sequences[k].start);
+        }
         cJSON_AddItemToArray(seqs, s);
     }
     return o;

@@ -19,5 +19,11 @@ uint64_t tcb_sequence_fingerprint(const tcb_sequence *s)
     if (s->pools) h = tcb_fnv1a64(h, s->pools, np * sizeof *s->pools);
     for (int k = 0; k < s->n_blocks; k++)
         h = tcb_fnv1a64(h, &s->blocks[k].start, sizeof s->blocks[k].start);
+    /* Only when given, so that the fingerprints of sequences without input
+     * normals (every one before them) stay what their records hold. */
+    if (s->input_normals != TCB_INPUT_NORMALS_NONE) {
+        int32_t normals = (int32_t)s->input_normals;
+        h = tcb_fnv1a64(h, &normals, sizeof normals);
+    }
     return h;
 }

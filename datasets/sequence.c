@@ -76,21 +76,67 @@ static int first_frame_transform(const tcb_sequence *s, double c[3], double *sca
     return TCB_OK;
 }
 
+/* CLIP_BBOX: c = the centre of the box of every frame's vertices, scale =
+ * half its largest extent / 0.95 (Neu-PiG's and PDG's frame: the
+ * sequence fills 95 % of [-1, 1]³). */
+static int clip_bbox_transform(const tcb_sequence *s, double c[3], double *scale, tcb_error *err)
+{
+    double box[6];
+    tcb_bbox(s->verts, (size_t)s->n_frames * (size_t)s->n_verts, box);
+    *scale = 0.0;
+    for (int d = 0; d < 3; d++) {
+        c[d] = 0.5 * (box[d] + box[3 + d]);
+        *scale = fmax(*scale, 0.5 * (box[3 + d] - box[d]));
+    }
+    *scale /= TCB_CLIP_BBOX_MARGIN;
+    if (!(*scale > 0.0) || !isfinite(*scale))
+        return tcb_fail(err, TCB_ERR_INPUT, "sequence %s: its frames' box has half extent %g, cannot normalize",
+                        s->name, *scale * TCB_CLIP_BBOX_MARGIN);
+    return TCB_OK;
+}
+
+/* FIRST_FRAME_DIAG: c = frame 0's vertex mean, scale = the diagonal of
+ * frame 0's bounding box (DynoSurf's frame). */
+static int first_frame_diag_transform(const tcb_sequence *s, double c[3], double *scale, tcb_error *err)
+{
+    double unused;
+    int rc = first_frame_transform(s, c, &unused, err);
+    if (rc) return rc;
+    double box[6];
+    tcb_bbox(tcb_seq_frame(s, 0), (size_t)s->n_verts, box);
+    *scale = tcb_bbox_diag(box);
+    if (!(*scale > 0.0) || !isfinite(*scale))
+        return tcb_fail(err, TCB_ERR_INPUT, "sequence %s: first frame has diagonal %g, cannot normalize",
+                        s->name, *scale);
+    return TCB_OK;
+}
+
+/* The similarity every frame gets (none and per_frame: identity here;
+ * per_frame centres each frame below). */
+static int norm_transform(const tcb_sequence *s, tcb_normalization mode, double c[3], double *scale, tcb_error *err)
+{
+    c[0] = c[1] = c[2] = 0.0, *scale = 1.0;
+    switch (mode) {
+    case TCB_NORM_NONE:
+    case TCB_NORM_PER_FRAME: return TCB_OK;
+    case TCB_NORM_FIRST_FRAME: return first_frame_transform(s, c, scale, err);
+    case TCB_NORM_CLIP_BBOX: return clip_bbox_transform(s, c, scale, err);
+    case TCB_NORM_FIRST_FRAME_DIAG: return first_frame_diag_transform(s, c, scale, err);
+    }
+    return tcb_fail(err, TCB_ERR_INPUT, "sequence %s: unknown normalization %d", s->name, (int)mode);
+}
+
 int tcb_sequence_normalize(tcb_sequence *s, tcb_normalization mode, tcb_error *err)
 {
     if (s->pools)
         return tcb_fail(err, TCB_ERR_INTERNAL, "sequence %s: normalize before sampling pools", s->name);
-    if (mode != TCB_NORM_NONE && mode != TCB_NORM_FIRST_FRAME && mode != TCB_NORM_PER_FRAME)
-        return tcb_fail(err, TCB_ERR_INPUT, "sequence %s: unknown normalization %d", s->name, (int)mode);
+    double c[3], scale;
+    int rc = norm_transform(s, mode, c, &scale, err);
+    if (rc) return rc;
     if (!s->areas) s->areas = malloc((size_t)s->n_frames * sizeof *s->areas);
     if (!s->norm_shift) s->norm_shift = malloc((size_t)s->n_frames * 3 * sizeof *s->norm_shift);
     if (!s->areas || !s->norm_shift)
         return tcb_fail(err, TCB_ERR_NOMEM, "sequence %s: out of memory", s->name);
-    double c[3] = {0, 0, 0}, scale = 1.0;
-    if (mode == TCB_NORM_FIRST_FRAME) {
-        int rc = first_frame_transform(s, c, &scale, err);
-        if (rc) return rc;
-    }
     for (int f = 0; f < s->n_frames; f++) {
         float *v = s->verts + (size_t)f * s->n_verts * 3;
         double *shift = s->norm_shift + 3 * (size_t)f;
@@ -104,6 +150,30 @@ int tcb_sequence_normalize(tcb_sequence *s, tcb_normalization mode, tcb_error *e
     }
     s->norm = mode;
     s->norm_scale = scale;
+    return TCB_OK;
+}
+
+int tcb_sequence_cut(const tcb_sequence *from, int start, int n_frames, const char *name, tcb_sequence *out,
+                     tcb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    int lo, hi;
+    if (start < 0 || n_frames < 1 || start + n_frames > from->n_frames)
+        return tcb_fail(err, TCB_ERR_INPUT, "sequence %s has %d frames: no frames %d-%d to cut %s from", from->name,
+                        from->n_frames, start, start + n_frames - 1, name);
+    int block = tcb_seq_block_of(from, start, &lo, &hi);
+    if (start + n_frames > hi)
+        return tcb_fail(err, TCB_ERR_INPUT, "sequence %s: frames %d-%d of %s cross the end of block %s (frames %d-%d)",
+                        from->name, start, start + n_frames - 1, name,
+                        block >= 0 && from->n_blocks ? from->blocks[block].name : "?", lo, hi - 1);
+    int rc = tcb_sequence_alloc(out, name, n_frames, from->n_verts, from->n_faces, err);
+    if (rc) return rc;
+    size_t frame = (size_t)from->n_verts * 3;
+    memcpy(out->verts, from->verts + (size_t)start * frame, (size_t)n_frames * frame * sizeof *out->verts);
+    memcpy(out->faces, from->faces, (size_t)from->n_faces * 3 * sizeof *out->faces);
+    out->input_points = from->input_points;
+    out->draw_with_replacement = from->draw_with_replacement;
+    out->input_normals = from->input_normals;
     return TCB_OK;
 }
 

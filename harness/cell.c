@@ -351,7 +351,11 @@ static void evaluate_clips(const tcb_cell_job *job, void *self, eval_bufs *b, tc
         int done = first + k * CLIP_PAIRS;
         if (stop_requested(job, done, total, herr)) return;
         eval_clip(job, self, k, done, b->box, b->moved, &c->clips[k], merr);
+        c->clips[k].corr_mesh = NAN;
+        if (!merr->code && tcb_method_has_surface(job->ops)) tcb_cell_corr_mesh(job, self, k, &c->clips[k], merr, herr);
+        if (merr->code || herr->code) break;
         tcb_stat_push(&c->summary.corr, c->clips[k].corr);
+        if (!isnan(c->clips[k].corr_mesh)) tcb_stat_push(&c->summary.corr_mesh, c->clips[k].corr_mesh);
         tcb_report_progress(&job->reporter, done + CLIP_PAIRS, total, label);
     }
     c->n_clips = clips->n_clips;
@@ -423,6 +427,7 @@ static int run_cell(const tcb_cell_job *job, tcb_cell_result *out, tcb_error *er
     int prepared = prepare_method(job, &self, &out->fit_s, &merr) == TCB_OK;
     double t1 = tcb_now_seconds();
     if (prepared) {
+        snprintf(out->normals, sizeof out->normals, "%s", tcb_method_normals(job->ops, self, job->seq));
         evaluate(job, self, out, &merr, &herr);
         job->ops->destroy(self);
     }

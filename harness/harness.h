@@ -19,12 +19,12 @@
  * (harness/runner.c) */
 int tcb_harness_load_plugins(const tcb_config *cfg, tcb_error *err);
 
-/* The sequence as the runner loads it for dataset d: generated or read
+/* Sequence s of dataset d as the runner loads it: generated or read
  * (through the cache; a cache entry refused is said to `reporter`, which
- * may be NULL), normalized, pools drawn, input settings set. On failure
- * *seq is freed and the message names dataset and sequence.
- * (harness/runner.c) */
-int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, const char *name,
+ * may be NULL), normalized, pools drawn, input settings set; a clip of
+ * another sequence (s->clip_of) cut out of it first. On failure *seq is
+ * freed and the message names dataset and sequence. (harness/runner.c) */
+int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, const tcb_sequence_spec *s,
                               const tcb_reporter *reporter, tcb_sequence *seq, tcb_error *err);
 /* <splits_dir>/<dataset>/<sequence>.json: where the sequence's split lives. */
 int tcb_harness_split_path(const tcb_config *cfg, const tcb_dataset_spec *d, const tcb_sequence_spec *s,
@@ -73,6 +73,9 @@ typedef struct tcb_cell_job {
     /* Samples per mesh of the reconstruction metrics ("evaluation.
      * surface_samples"); 0: not computed (a job that does not set it). */
     int surface_samples;
+    /* The frame the reconstruction metrics are measured in ("evaluation.
+     * recon_frame"; 0, the sequence's, in a job that does not set it). */
+    tcb_recon_frame recon_frame;
 } tcb_cell_job;
 
 /* Creates job's method and loads (or, for methods without checkpoints,

@@ -137,6 +137,19 @@ void tcb_slurm_queue_free(tcb_slurm_queue *q);
  * fails with a readable message (harness/cell.c). */
 void tcb_cell_ensure_error(tcb_error *merr, int rc);
 
+/* The method's surface of `frame` into *m (freed on failure), drawn from
+ * the stream "surface/<dataset>/<sequence>/<frame>" of the cell's seed,
+ * which *rng is left at, and checked (tcb_surface_check); failures are
+ * the method's (harness/cell_surface.c). */
+int tcb_cell_method_surface(const tcb_cell_job *job, void *self, int frame, tcb_rng *rng, tcb_uv_mesh *m,
+                            tcb_error *merr);
+
+/* DynoSurf's Corr of clip c of job->clips into rec->corr_mesh (NAN when the
+ * method's surfaces change topology within the clip), for a method with
+ * surfaces (harness/cell_corr_mesh.c). */
+void tcb_cell_corr_mesh(const tcb_cell_job *job, void *self, int c, tcb_clip_record *rec, tcb_error *merr,
+                        tcb_error *herr);
+
 /* The reconstruction metrics of the cell's evaluated frames (every frame of
  * the split's pairs and of the clips, once each, ascending) into
  * c->surface and c->summary.recon, when the method gives surfaces and

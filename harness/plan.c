@@ -35,8 +35,8 @@ static void duration_text(double s, char *out, size_t size)
     else snprintf(out, size, "%.1f h", s / 3600);
 }
 
-/* Frames and vertices of sequence s of d; 0, 0 when the data are absent. */
-static void probe(const tcb_dataset_spec *d, const char *name, int *n_frames, int *n_verts)
+/* Frames and vertices of sequence `name` of d; 0, 0 when the data are absent. */
+static void probe_source(const tcb_dataset_spec *d, const char *name, int *n_frames, int *n_verts)
 {
     tcb_error err = {0};
     *n_frames = *n_verts = 0;
@@ -55,6 +55,15 @@ static void probe(const tcb_dataset_spec *d, const char *name, int *n_frames, in
                  ? TCB_ERR_INPUT
                  : tcb_sequence_probe_objdir(dir, n_frames, n_verts, &err);
     if (rc) *n_frames = *n_verts = 0;
+}
+
+/* The same for a grid sequence: a clip (s->clip_of) has its clip's frames
+ * when its sequence reaches that far. */
+static void probe(const tcb_dataset_spec *d, const tcb_sequence_spec *s, int *n_frames, int *n_verts)
+{
+    probe_source(d, s->clip_of[0] ? s->clip_of : s->name, n_frames, n_verts);
+    if (s->clip_of[0] && *n_frames >= s->start + TCB_CLIP_FRAMES) *n_frames = TCB_CLIP_FRAMES;
+    else if (s->clip_of[0]) *n_frames = *n_verts = 0;
 }
 
 /* done, failed, diverged, unreadable, missing, "running (host pid, age;
@@ -145,20 +154,23 @@ typedef struct plan_walk {
     plan_totals t;
 } plan_walk;
 
-static void sequence_header(plan_walk *w, const tcb_dataset_spec *d, const char *seq)
+static void sequence_header(plan_walk *w, const tcb_dataset_spec *d, const tcb_sequence_spec *s)
 {
-    if (tcb_run_root_missing(d) && seq == d->sequences[0].name) {
+    const char *seq = s->name;
+    if (tcb_run_root_missing(d) && s == &d->sequences[0]) {
         char why[TCB_PATH_MAX + 64];
         tcb_run_missing_root_text(d, why, sizeof why);
         fprintf(w->out, "dataset %s: %s%s\n", d->name, why, d->optional ? " (optional: skipped by a run)" : "");
     }
     /* The clip protocol's transfers count as pairs (16 a clip; at most
-     * the configured clips, fewer on a short sequence). */
+     * the configured clips, fewer on a short sequence; one fitted per
+     * clip is one clip). */
     const tcb_config *c = w->cfg;
+    int clips = c->fit_per_clip ? 1 : c->eval_clips;
     int pairs = (c->protocols & TCB_PROTOCOL_PAIRS ? c->eval_pairs : 0) +
-                (c->protocols & TCB_PROTOCOL_CLIPS ? c->eval_clips * (TCB_CLIP_FRAMES - 1) : 0);
+                (c->protocols & TCB_PROTOCOL_CLIPS ? clips * (TCB_CLIP_FRAMES - 1) : 0);
     w->q = (tcb_cost_query){0, 0, pairs, c->threads};
-    probe(d, seq, &w->q.n_frames, &w->q.n_verts);
+    probe(d, s, &w->q.n_frames, &w->q.n_verts);
     if (w->q.n_frames)
         fprintf(w->out, "%s/%s: %d frames, %d vertices, %d pairs\n", d->name, seq, w->q.n_frames, w->q.n_verts,
                 w->q.n_pairs);
@@ -183,7 +195,7 @@ static int plan_cell(void *ctx, const tcb_grid_cell *c)
 {
     plan_walk *w = ctx;
     if (!tcb_run_selected(w->opts, c->method) || (w->opts->cells && !w->opts->cells[c->id])) return TCB_OK;
-    if (w->current != c->sequence) sequence_header(w, c->dataset, c->sequence->name);
+    if (w->current != c->sequence) sequence_header(w, c->dataset, c->sequence);
     w->current = c->sequence;
     tcb_cost_estimate e;
     estimate_cell(w->cals, c->method, &w->q, w->cfg->surface_samples, &e);

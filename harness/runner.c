@@ -97,31 +97,56 @@ int tcb_run_check_methods(const tcb_config *cfg, const tcb_run_opts *opts, tcb_e
     return TCB_OK;
 }
 
-int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, const char *name,
+/* Sequence `name` of d as its source gives it, prepared with *lo. */
+static int load_source(const tcb_dataset_spec *d, const char *name, const tcb_load_opts *lo, tcb_sequence *seq,
+                       tcb_error *err)
+{
+    if (d->source == TCB_SOURCE_SYNTHETIC) {
+        int rc = tcb_synth_generate(name, d->seed, d->frames, seq, err);
+        return rc ? rc : tcb_sequence_prepare(seq, lo, err);
+    }
+    if (d->source == TCB_SOURCE_DFAUST)
+        return tcb_sequence_load_dfaust(d->root, name, d->subjects, d->n_subjects, lo, seq, err);
+    char dir[TCB_PATH_MAX];
+    int rc = tcb_path_join(dir, sizeof dir, err, "%s/%s", d->root, name);
+    if (!rc && !tcb_is_dir(dir)) rc = tcb_fail(err, TCB_ERR_IO, "%s: no such directory", dir);
+    return rc ? rc : tcb_sequence_load_objdir(dir, name, lo, seq, err);
+}
+
+/* A clip of sequence s->clip_of fitted on its own: that sequence read
+ * raw (no normalization, no alignment: both are the clip's own), the
+ * clip's frames cut out and prepared as a sequence named s->name. */
+static int load_clip(const tcb_dataset_spec *d, const tcb_sequence_spec *s, const tcb_load_opts *lo,
+                     tcb_sequence *seq, tcb_error *err)
+{
+    tcb_load_opts raw = *lo;
+    raw.norm = TCB_NORM_NONE, raw.align_samples = 0;
+    tcb_sequence whole = {0};
+    int rc = load_source(d, s->clip_of, &raw, &whole, err);
+    if (!rc) rc = tcb_sequence_cut(&whole, s->start, TCB_CLIP_FRAMES, s->name, seq, err);
+    tcb_sequence_free(&whole);
+    return rc ? rc : tcb_sequence_prepare(seq, lo, err);
+}
+
+int tcb_harness_load_sequence(const tcb_config *cfg, const tcb_dataset_spec *d, const tcb_sequence_spec *s,
                               const tcb_reporter *reporter, tcb_sequence *seq, tcb_error *err)
 {
-    int rc;
     tcb_load_opts lo = {d->norm, cfg->pool_size, cfg->pool_seed, cfg->cache_dir[0] ? cfg->cache_dir : NULL,
                         d->align_samples, reporter};
-    if (d->source == TCB_SOURCE_SYNTHETIC) {
-        rc = tcb_synth_generate(name, d->seed, d->frames, seq, err);
-        if (!rc) rc = tcb_sequence_prepare(seq, &lo, err);
-    } else if (d->source == TCB_SOURCE_DFAUST) {
-        rc = tcb_sequence_load_dfaust(d->root, name, d->subjects, d->n_subjects, &lo, seq, err);
-    } else {
-        char dir[TCB_PATH_MAX];
-        rc = tcb_path_join(dir, sizeof dir, err, "%s/%s", d->root, name);
-        if (!rc && !tcb_is_dir(dir))
-            rc = tcb_fail(err, TCB_ERR_IO, "%s: no such directory", dir);
-        if (!rc) rc = tcb_sequence_load_objdir(dir, name, &lo, seq, err);
-    }
+    int rc = s->clip_of[0] ? load_clip(d, s, &lo, seq, err) : load_source(d, s->name, &lo, seq, err);
+    if (!rc && cfg->fit_per_clip && seq->n_frames != TCB_CLIP_FRAMES)
+        rc = tcb_fail(err, TCB_ERR_INPUT,
+                      "fitted per clip, a sequence is one clip of %d frames, this one has %d (name its clips "
+                      "with \"clip_starts\")",
+                      TCB_CLIP_FRAMES, seq->n_frames);
     if (rc) {
         tcb_sequence_free(seq);
-        tcb_error_prefix(err, "dataset %s, sequence %s: ", d->name, name);
+        tcb_error_prefix(err, "dataset %s, sequence %s: ", d->name, s->name);
         return rc;
     }
     seq->input_points = cfg->input_points;
     seq->draw_with_replacement = d->with_replacement;
+    seq->input_normals = cfg->input_normals;
     return TCB_OK;
 }
 
@@ -133,7 +158,7 @@ int tcb_run_load_sequence(const tcb_config *cfg, const char *dataset, const char
     memset(out, 0, sizeof *out);
     int rc = tcb_config_find_sequence(cfg, dataset, sequence, &d, &s, err);
     if (!rc) rc = tcb_run_check_root(cfg, d, err);
-    return rc ? rc : tcb_harness_load_sequence(cfg, d, s->name, NULL, out, err);
+    return rc ? rc : tcb_harness_load_sequence(cfg, d, s, NULL, out, err);
 }
 
 int tcb_harness_split_path(const tcb_config *cfg, const tcb_dataset_spec *d, const tcb_sequence_spec *s,
@@ -260,6 +285,7 @@ static int run_cell(const run_state *st, const seq_ctx *sc, const tcb_method_spe
         .clips = sc->clips,
         .clips_path = sc->clips_path,
         .surface_samples = st->cfg->surface_samples,
+        .recon_frame = st->cfg->recon_frame,
     };
     char label[TCB_CELL_LABEL_MAX];
     tcb_cell_label(label, sizeof label, sc->dataset->name, sc->seq->name, m->label, seed);
@@ -392,7 +418,7 @@ static int run_sequence(const run_state *st, const tcb_dataset_spec *d, const tc
     char split_path[TCB_PATH_MAX], clips_path[TCB_PATH_MAX] = "";
     double t0 = tcb_now_seconds();
     tcb_report_log(&st->opts->reporter, TCB_LOG_INFO, "%s/%s: loading", d->name, s->name);
-    int rc = tcb_harness_load_sequence(st->cfg, d, s->name, &st->opts->reporter, &seq, err);
+    int rc = tcb_harness_load_sequence(st->cfg, d, s, &st->opts->reporter, &seq, err);
     if (rc) return rc;
     int with_clips = st->cfg->protocols & TCB_PROTOCOL_CLIPS;
     seq_ctx sc = {d, &seq, &split, split_path, with_clips ? &clips : NULL, clips_path, tcb_now_seconds() - t0};

@@ -75,7 +75,7 @@ static int load(tcb_evaluator *ev, tcb_error *err)
 {
     double t0 = tcb_now_seconds();
     int rc = tcb_run_check_root(ev->cfg, ev->d, err);
-    if (!rc) rc = tcb_harness_load_sequence(ev->cfg, ev->d, ev->s->name, NULL, &ev->seq, err);
+    if (!rc) rc = tcb_harness_load_sequence(ev->cfg, ev->d, ev->s, NULL, &ev->seq, err);
     if (rc) return rc;
     ev->load_s = tcb_now_seconds() - t0;
     rc = tcb_harness_obtain_split(ev->cfg, ev->d, ev->s, &ev->seq, ev->split_path, sizeof ev->split_path,

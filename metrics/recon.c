@@ -11,6 +11,20 @@
 #include "tcb/nn.h"
 
 const char *const tcb_recon_names[TCB_N_RECON] = {"cdl2", "nc", "fscore05", "fscore1"};
+const char *const tcb_recon_frame_names[] = {"sequence", "frame_box", NULL};
+
+void tcb_frame_box_map(const float *gt, int n, double centre[3], double *scale)
+{
+    double box[6], extent = 0.0;
+    tcb_bbox(gt, (size_t)n, box);
+    for (int d = 0; d < 3; d++) centre[d] = 0.5 * (box[d] + box[3 + d]), extent = fmax(extent, box[3 + d] - box[d]);
+    *scale = extent > 0.0 ? 1.0 / extent : 0.0;
+}
+
+void tcb_frame_box_apply(const double centre[3], double scale, float *pts, int n)
+{
+    for (size_t i = 0; i < 3 * (size_t)n; i++) pts[i] = (float)((pts[i] - centre[i % 3]) * scale);
+}
 
 int tcb_recon_sample(const float *verts, const int32_t *faces, int nf, int n, tcb_rng *rng,
                      float *pts, float *normals, tcb_error *err)

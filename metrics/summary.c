@@ -25,6 +25,7 @@ static void merge_geodesic(tcb_summary *into, const tcb_summary *other)
 void tcb_summary_merge(tcb_summary *into, const tcb_summary *other)
 {
     tcb_stat_merge(&into->corr, &other->corr); /* clips: a cell may have them without pairs */
+    tcb_stat_merge(&into->corr_mesh, &other->corr_mesh);
     for (int m = 0; m < TCB_N_RECON; m++) tcb_stat_merge(&into->recon[m], &other->recon[m]); /* over frames */
     if (other->n_pairs == 0) return;
     int n = into->n_pairs + other->n_pairs;

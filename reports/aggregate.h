@@ -28,6 +28,7 @@ typedef enum tcb_rpt_metric {
     TCB_M_GEO,      /* the geodesic error and its AUC: tcbench's addition */
     TCB_M_GEO_AUC,
     TCB_M_CORR,     /* the clip protocol's tracking error (DynoSurf/PDG/Neu-PiG), over clips */
+    TCB_M_CORR_MESH, /* the same as DynoSurf's script computes it, from surfaces of one topology */
     TCB_M_CDL2,     /* the reconstruction metrics (tcb/metrics.h, TCB_RECON_* in this order), */
     TCB_M_NC,       /* over the evaluated frames of the methods that give surfaces */
     TCB_M_FSCORE05,
@@ -163,6 +164,9 @@ const tcb_rpt_cmp *tcb_rpt_cmp_of(const tcb_rpt_block *b, int ra, int rb, int *f
  * (tcb_cmp_significant, the difference in r's favour). */
 int tcb_rpt_beats(const tcb_rpt_block *b, int r, int o, int m);
 void tcb_rpt_free(tcb_rpt *r);
+/* Whether a table of dataset d shows metric m: some row of its blocks has
+ * it (a pairs-only run has no Corr column, a clips-only run no m_sL2). */
+int tcb_rpt_dataset_shows(const tcb_rpt *r, const tcb_rpt_dataset *d, int m);
 
 /* One table cell: "mean<pm>std" in the metric's precision, "-" when the row
  * has no value, or the row's status when it is not ok (the tables explain

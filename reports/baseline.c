@@ -19,7 +19,7 @@ static const char *const TOP_KEYS[] = {"format", "tolerances", "rows", NULL};
 static const char *const TOL_KEYS[] = {"abs", "rel", NULL};
 static const char *const ROW_KEYS[] = {"dataset", "sequence", "method", "sl2",
                                        "rank",    "auc",      "cd",     "geo",
-                                       "geo_auc", "corr",     "cdl2",   "nc",
+                                       "geo_auc", "corr",     "corr_mesh", "cdl2", "nc",
                                        "fscore05", "fscore1", "status",   "tolerances", NULL};
 
 /* ----------------------------------------------------------------- write */

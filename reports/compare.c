@@ -13,6 +13,7 @@
 
 _Static_assert((int)TCB_CMP_N_METRICS == (int)TCB_N_METRICS, "compare.h's metrics are the report's columns");
 _Static_assert((int)TCB_CMP_SL2 == (int)TCB_M_SL2 && (int)TCB_CMP_CD == (int)TCB_M_CD && (int)TCB_CMP_CORR == (int)TCB_M_CORR &&
+                   (int)TCB_CMP_CORR_MESH == (int)TCB_M_CORR_MESH &&
                    (int)TCB_CMP_CDL2 == (int)TCB_M_CDL2 && (int)TCB_CMP_FSCORE1 == (int)TCB_M_FSCORE1 &&
                    (int)TCB_CMP_GEO_AUC == (int)TCB_M_GEO_AUC,
                "compare.h's metrics are in the report's column order");
@@ -23,7 +24,7 @@ const char *tcb_cmp_metric_label(int metric)
 {
     static const char *const labels[TCB_CMP_N_METRICS] = {"m_sL2 ×1e3", "rank %",     "AUC %",   "CD ×1e3",
                                                           "m_geo ×1e3", "AUC_geo %", "Corr ×1e3",
-                                                          "CD-L2 ×1e3", "NC %",      "F@0.5% %", "F@1% %"};
+                                                          "Corr-mesh ×1e3", "CD-L2 ×1e3", "NC %",      "F@0.5% %", "F@1% %"};
     return labels[metric];
 }
 
@@ -51,12 +52,13 @@ static int is_recon(int m) { return m >= TCB_M_CDL2 && m <= TCB_M_FSCORE1; }
  * the reconstruction metrics, else pairs. */
 static int units(const tcb_cell_result *c, int m)
 {
-    return m == TCB_M_CORR ? c->n_clips : is_recon(m) ? c->n_surface : c->n_pairs;
+    return m == TCB_M_CORR || m == TCB_M_CORR_MESH ? c->n_clips : is_recon(m) ? c->n_surface : c->n_pairs;
 }
 
 static double unit_value(const tcb_cell_result *c, int u, int m)
 {
     if (is_recon(m)) return c->surface[u].v[m - TCB_M_CDL2];
+    if (m == TCB_M_CORR_MESH) return c->clips[u].corr_mesh;
     return m == TCB_M_CORR ? c->clips[u].corr : pair_value(&c->pairs[u], m);
 }
 

@@ -75,9 +75,12 @@ static void write_row(FILE *f, const tcb_rpt_block *b, const tcb_rpt_row *r)
     /* Corr, added after geo_unreachable, goes after it; then the marks; the
      * reconstruction metrics, added after the marks, after them with theirs. */
     put_mean_std(f, r, TCB_M_CORR);
-    put_marks(f, r, 0, TCB_M_CDL2);
+    put_marks(f, r, 0, TCB_M_CORR + 1);
     for (int m = TCB_M_CDL2; m < TCB_N_METRICS; m++) put_mean_std(f, r, m);
     put_marks(f, r, TCB_M_CDL2, TCB_N_METRICS);
+    /* DynoSurf's Corr, added after the reconstruction metrics, last. */
+    put_mean_std(f, r, TCB_M_CORR_MESH);
+    put_marks(f, r, TCB_M_CORR_MESH, TCB_M_CORR_MESH + 1);
     fputc('\n', f);
 }
 
@@ -89,7 +92,7 @@ void tcb_rpt_write_csv(FILE *f, const tcb_rpt *r)
           "geo_auc_pct_std,geo_unreachable,corr_x1e3_mean,corr_x1e3_std,sl2_mark,rank_mark,auc_mark,"
           "cd_mark,geo_mark,geo_auc_mark,corr_mark,cdl2_x1e3_mean,cdl2_x1e3_std,nc_pct_mean,nc_pct_std,"
           "fscore05_pct_mean,fscore05_pct_std,fscore1_pct_mean,fscore1_pct_std,cdl2_mark,nc_mark,fscore05_mark,"
-          "fscore1_mark\n",
+          "fscore1_mark,corr_mesh_x1e3_mean,corr_mesh_x1e3_std,corr_mesh_mark\n",
           f);
     for (int d = 0; d < r->n_datasets; d++) {
         const tcb_rpt_dataset *ds = &r->datasets[d];
@@ -122,7 +125,7 @@ void tcb_rpt_write_seed_csv(FILE *f, const tcb_rpt *r)
 {
     fputs("dataset,sequence,role,method,seed,status,n_pairs,sl2_x1e3_mean,rank_pct_mean,"
           "auc_pct_mean,cd_x1e3_mean,geo_x1e3_mean,geo_auc_pct_mean,corr_x1e3_mean,cdl2_x1e3_mean,nc_pct_mean,"
-          "fscore05_pct_mean,fscore1_pct_mean\n",
+          "fscore05_pct_mean,fscore1_pct_mean,corr_mesh_x1e3_mean\n",
           f);
     for (int k = 0; k < r->n_blocks; k++)
         for (int i = 0; i < r->blocks[k].n_rows; i++) {
@@ -131,8 +134,10 @@ void tcb_rpt_write_seed_csv(FILE *f, const tcb_rpt *r)
                 const tcb_rpt_seed *s = &row->by_seed[j];
                 put_block(f, &r->blocks[k], row);
                 fprintf(f, ",%d,%s,%d", s->seed, s->status, s->n_pairs);
+                /* every metric in the report's order, but corr_mesh, added later, last */
                 for (int m = 0; m < TCB_N_METRICS; m++)
-                    put_num(f, s->has[m], s->mean[m], tcb_rpt_metrics[m].decimals);
+                    if (m != TCB_M_CORR_MESH) put_num(f, s->has[m], s->mean[m], tcb_rpt_metrics[m].decimals);
+                put_num(f, s->has[TCB_M_CORR_MESH], s->mean[TCB_M_CORR_MESH], tcb_rpt_metrics[TCB_M_CORR_MESH].decimals);
                 fputc('\n', f);
             }
         }

@@ -98,12 +98,14 @@ static void write_marks_legend(FILE *f, const tcb_rpt_block *b)
     fprintf(f, "\n");
 }
 
-static void write_table(FILE *f, const tcb_rpt_block *b)
+static void write_table(FILE *f, const tcb_rpt_block *b, const unsigned char *shown)
 {
     fprintf(f, "| method |");
-    for (int m = 0; m < TCB_N_METRICS; m++) fprintf(f, " %s |", tcb_rpt_metrics[m].label);
+    for (int m = 0; m < TCB_N_METRICS; m++)
+        if (shown[m]) fprintf(f, " %s |", tcb_rpt_metrics[m].label);
     fprintf(f, "\n|:---|");
-    for (int m = 0; m < TCB_N_METRICS; m++) fprintf(f, "---:|");
+    for (int m = 0; m < TCB_N_METRICS; m++)
+        if (shown[m]) fprintf(f, "---:|");
     fprintf(f, "\n");
     for (int k = 0; k < b->n_rows; k++) {
         const tcb_rpt_row *r = &b->rows[k];
@@ -111,6 +113,7 @@ static void write_table(FILE *f, const tcb_rpt_block *b)
         fewer_seeds_note(b, r, note, sizeof note);
         fprintf(f, "| %s%s |", r->method, note);
         for (int m = 0; m < TCB_N_METRICS; m++) {
+            if (!shown[m]) continue;
             char cell[128];
             tcb_rpt_cell_text(r, m, " ± ", cell, sizeof cell);
             const char *em = r->best[m] ? "**" : strcmp(r->status, "ok") ? "*" : "";
@@ -147,16 +150,18 @@ static void seed_cell(const tcb_rpt_seed *s, int m, char *out, size_t size)
 
 /* Each cell's means, grouped by seed, best per seed in bold: whether the
  * ranking of the pooled table holds seed by seed. */
-static void write_seed_table(FILE *f, const tcb_rpt_block *b)
+static void write_seed_table(FILE *f, const tcb_rpt_block *b, const unsigned char *shown)
 {
     int several = 0;
     for (int k = 0; k < b->n_rows; k++) several |= b->rows[k].n_by_seed > 1;
     if (!several) return;
     fprintf(f, "Per seed (each cell's means; best per seed in **bold** by its value alone, untested: which "
                "differences are real, the table above and comparisons.md say):\n\n| seed | method |");
-    for (int m = 0; m < TCB_N_METRICS; m++) fprintf(f, " %s |", tcb_rpt_metrics[m].label);
+    for (int m = 0; m < TCB_N_METRICS; m++)
+        if (shown[m]) fprintf(f, " %s |", tcb_rpt_metrics[m].label);
     fprintf(f, "\n|---:|:---|");
-    for (int m = 0; m < TCB_N_METRICS; m++) fprintf(f, "---:|");
+    for (int m = 0; m < TCB_N_METRICS; m++)
+        if (shown[m]) fprintf(f, "---:|");
     fprintf(f, "\n");
     for (int d = 0; d < b->n_seed_list; d++)
         for (int k = 0; k < b->n_rows; k++)
@@ -165,6 +170,7 @@ static void write_seed_table(FILE *f, const tcb_rpt_block *b)
                 if (s->seed != b->seed_list[d]) continue;
                 fprintf(f, "| %d | %s |", s->seed, b->rows[k].method);
                 for (int m = 0; m < TCB_N_METRICS; m++) {
+                    if (!shown[m]) continue;
                     char cell[64];
                     seed_cell(s, m, cell, sizeof cell);
                     fprintf(f, " %s |", cell);
@@ -189,6 +195,8 @@ static void write_plot_links(FILE *f, const tcb_rpt_block *b)
 
 static void write_dataset(FILE *f, const tcb_rpt *r, const tcb_rpt_dataset *d)
 {
+    unsigned char shown[TCB_N_METRICS];
+    for (int m = 0; m < TCB_N_METRICS; m++) shown[m] = (unsigned char)tcb_rpt_dataset_shows(r, d, m);
     fprintf(f, "## %s\n\n", d->name);
     for (int k = d->first; k < d->first + d->n; k++) {
         const tcb_rpt_block *b = &r->blocks[k];
@@ -196,8 +204,8 @@ static void write_dataset(FILE *f, const tcb_rpt *r, const tcb_rpt_dataset *d)
         pairs_text(b, pairs, sizeof pairs);
         fprintf(f, "### %s / %s\n\nrole: %s · pairs: %s · seeds: %s\n\n", d->name, b->sequence,
                 b->role, pairs, b->seeds);
-        write_table(f, b);
-        write_seed_table(f, b);
+        write_table(f, b, shown);
+        write_seed_table(f, b, shown);
         write_plot_links(f, b);
     }
     if (!d->n_test) {
@@ -208,7 +216,7 @@ static void write_dataset(FILE *f, const tcb_rpt *r, const tcb_rpt_dataset *d)
             "### %s / MEAN\n\nmean over the %d test sequence%s (%s) of the per-sequence means, "
             "and separately of the per-sequence stds\n\n",
             d->name, d->n_test, d->n_test == 1 ? "" : "s", d->test_sequences);
-    write_table(f, &d->mean);
+    write_table(f, &d->mean, shown);
 }
 
 void tcb_rpt_write_md(FILE *f, const tcb_rpt *r)
@@ -221,7 +229,9 @@ void tcb_rpt_write_md(FILE *f, const tcb_rpt *r)
                "the geodesic error (docs/protocol.md): m_geo ×1e3 (path length on the target "
                "mesh over sqrt(its area), over all vertices of all pairs) and AUC_geo %% (its "
                "PCK up to 0.25, over pairs); \"-\" there: cells scored before it existed. Corr ×1e3: the "
-               "clip protocol's tracking error, over clips. CD-L2 ×1e3, NC %% and F-score %% at 0.5 %% and "
+               "clip protocol's tracking error, over clips; Corr-mesh ×1e3: the same as DynoSurf's script "
+               "computes it, from the method's surfaces of one topology (docs/protocol.md). A column no "
+               "method of a dataset has is left out. CD-L2 ×1e3, NC %% and F-score %% at 0.5 %% and "
                "1 %% (F@0.5%%, F@1%%): the reconstruction metrics of DynoSurf's evaluation, over the "
                "evaluated frames; \"-\" there: the method gives no surface (or its cells predate them).\n\n");
     tcb_rpt_write_presets_md(f, r);

@@ -19,7 +19,7 @@ void tcb_rpt_tex_escaped(FILE *f, const char *s)
     }
 }
 
-static void write_block(FILE *f, const tcb_rpt_block *b, const char *title)
+static void write_block(FILE *f, const tcb_rpt_block *b, const char *title, const unsigned char *shown)
 {
     for (int k = 0; k < b->n_rows; k++) {
         const tcb_rpt_row *r = &b->rows[k];
@@ -27,6 +27,7 @@ static void write_block(FILE *f, const tcb_rpt_block *b, const char *title)
         fputs(" & ", f);
         tcb_rpt_tex_escaped(f, r->method);
         for (int m = 0; m < TCB_N_METRICS; m++) {
+            if (!shown[m]) continue;
             char cell[128];
             tcb_rpt_cell_text(r, m, " $\\pm$ ", cell, sizeof cell);
             if (r->best[m])
@@ -42,33 +43,37 @@ static void write_block(FILE *f, const tcb_rpt_block *b, const char *title)
 
 static void write_dataset(FILE *f, const tcb_rpt *r, const tcb_rpt_dataset *d)
 {
+    unsigned char shown[TCB_N_METRICS];
+    int n_shown = 0;
+    for (int m = 0; m < TCB_N_METRICS; m++) n_shown += shown[m] = (unsigned char)tcb_rpt_dataset_shows(r, d, m);
     fputs("\\begin{table}[t]\n\\centering\n\\caption{", f);
     tcb_rpt_tex_escaped(f, d->name);
     fputs(": m\\_sL2 $\\times 10^{3}$, rank \\%, AUC \\%, CD $\\times 10^{3}$, and the geodesic "
-          "error m\\_geo $\\times 10^{3}$ and AUC\\_geo \\%, Corr $\\times 10^{3}$, CD-L2 $\\times 10^{3}$, NC \\% "
+          "error m\\_geo $\\times 10^{3}$ and AUC\\_geo \\%, Corr and Corr-mesh (DynoSurf's computation) $\\times 10^{3}$, CD-L2 $\\times 10^{3}$, NC \\% "
           "and the F-scores at 0.5\\,\\% and 1\\,\\% in \\% (not in the paper's protocol) (mean "
           "$\\pm$ std); in bold the best when significantly better than every other method (Holm-adjusted "
           "Wilcoxon $p < 0.05$ over the block's comparisons of the column and the 95\\,\\% bootstrap interval of "
           "the difference excluding 0), else $^{\\approx}$ on the leaders tied for best; ``-'': no reconstruction "
           "(CD), no clips (Corr), no surface (CD-L2, NC, F) or not scored (geodesic). MEAN: over the test sequences, its intervals rough with few of them.}\n\\begin{tabular}{ll",
           f);
-    for (int m = 0; m < TCB_N_METRICS; m++) fputc('c', f);
+    for (int m = 0; m < n_shown; m++) fputc('c', f);
     fputs("}\n\\toprule\nSequence & Method", f);
-    for (int m = 0; m < TCB_N_METRICS; m++) fprintf(f, " & %s", tcb_rpt_metrics[m].tex_label);
+    for (int m = 0; m < TCB_N_METRICS; m++)
+        if (shown[m]) fprintf(f, " & %s", tcb_rpt_metrics[m].tex_label);
     fputs(" \\\\\n", f);
     for (int k = d->first; k < d->first + d->n; k++) {
         const tcb_rpt_block *b = &r->blocks[k];
         char title[160];
         snprintf(title, sizeof title, "%s (%s)", b->sequence, b->role);
         fputs("\\midrule\n", f);
-        write_block(f, b, title);
+        write_block(f, b, title, shown);
     }
     fputs("\\midrule\n", f);
     if (d->n_test)
-        write_block(f, &d->mean, "MEAN");
+        write_block(f, &d->mean, "MEAN", shown);
     else
         fprintf(f, "\\multicolumn{%d}{l}{\\textit{no test sequence: no MEAN}} \\\\\n",
-                2 + TCB_N_METRICS);
+                2 + n_shown);
     fputs("\\bottomrule\n\\end{tabular}\n\\end{table}\n\n", f);
 }
 

@@ -16,13 +16,13 @@ static const char *const TOP_KEYS[] = {
     "format",       "dataset",         "sequence", "role",        "method",
     "method_impl",  "params",          "seed",     "status",      "message",
     "git_revision", "tcbench_version", "timings",  "peak_rss_kb", "split",
-    "summary",      "pair_columns",    "pairs",    "clips",       "surface", "plugin", NULL};
+    "summary",      "pair_columns",    "pairs",    "clips",       "surface", "plugin", "normals", NULL};
 static const char *const TIMING_KEYS[] = {"load_s", "fit_s", "eval_s", NULL};
 static const char *const SPLIT_KEYS[] = {"path", "seed", "n_pairs", NULL};
 static const char *const PLUGIN_KEYS[] = {"path", "fnv1a64", "abi", "version", NULL};
 static const char *const SUMMARY_KEYS[] = {"n_pairs", "sl2",     "sl2sq",   "rank",
                                            "auc",     "cd",      "pck",     "geo",
-                                           "geo_auc", "geo_pck", "geo_unreachable", "corr",
+                                           "geo_auc", "geo_pck", "geo_unreachable", "corr",   "corr_mesh",
                                            "cdl2",    "nc",      "fscore05", "fscore1", NULL};
 /* The summary's geodesic keys: all or none (none in a cell written before
  * the geodesic error). */
@@ -31,7 +31,8 @@ static const char *const STAT_KEYS[] = {"n", "mean", "m2", NULL};
 /* The clip protocol's (absent in a cell without clips). */
 static const char *const CLIPS_KEYS[] = {"path", "seed", "clip_frames", "n_clips", "columns", "rows", NULL};
 /* The reconstruction metrics' (absent in a cell without them). */
-static const char *const SURFACE_KEYS[] = {"samples", "columns", "rows", NULL};
+static const char *const SURFACE_KEYS[] = {"samples", "frame", "columns", "rows", NULL};
+static const char *const NORMALS_NAMES[] = {"gt", "estimated", NULL};
 
 /* Key paths for messages ("file: summary.sl2.mean"); a path too long for
  * the buffer is cut, which only shortens a message. */
@@ -161,6 +162,7 @@ static int load_summary(const cJSON *root, const char *where, tcb_summary *s, tc
         return rc;
     if ((rc = load_curve(o, "pck", sub, TCB_PCK_STEPS, s->pck, err))) return rc;
     if (cJSON_HasObjectItem(o, "corr") && (rc = load_stat(o, "corr", sub, &s->corr, err))) return rc;
+    if (cJSON_HasObjectItem(o, "corr_mesh") && (rc = load_stat(o, "corr_mesh", sub, &s->corr_mesh, err))) return rc;
     for (int m = 0; m < TCB_N_RECON; m++)
         if (cJSON_HasObjectItem(o, tcb_recon_names[m]) &&
             (rc = load_stat(o, tcb_recon_names[m], sub, &s->recon[m], err)))
@@ -262,17 +264,21 @@ static int load_pairs(const cJSON *root, int n_cols, const char *where, tcb_cell
     return TCB_OK;
 }
 
-/* A clip's row: [start, corr, [err_1, …, err_16]]. */
-static int load_clip(const cJSON *row, const char *at, tcb_clip_record *r, tcb_error *err)
+/* A clip's row: [start, corr, [err_1, …, err_16]] and, with the
+ * corr_mesh column (n_cols 4), its value. */
+static int load_clip(const cJSON *row, int n_cols, const char *at, tcb_clip_record *r, tcb_error *err)
 {
     const int n_err = TCB_CLIP_FRAMES - 1;
-    const cJSON *e = cJSON_IsArray(row) && cJSON_GetArraySize(row) == 3 ? row->child->next->next : NULL;
+    const cJSON *e = cJSON_IsArray(row) && cJSON_GetArraySize(row) == n_cols ? row->child->next->next : NULL;
     if (!e || !cJSON_IsArray(e) || cJSON_GetArraySize(e) != n_err)
-        return tcb_fail(err, TCB_ERR_INPUT, "%s: expected [start, corr, [%d errors]]", at, n_err);
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: expected [start, corr, [%d errors]%s]", at, n_err,
+                        n_cols == 4 ? ", corr_mesh" : "");
     int rc = pair_index(row->child, at, &r->start, err);
     if (!rc) rc = value_or_null(row->child->next, at, &r->corr, err);
     int t = 0;
     for (const cJSON *v = e->child; v && !rc; v = v->next, t++) rc = value_or_null(v, at, &r->err[t], err);
+    r->corr_mesh = NAN;
+    if (!rc && n_cols == 4) rc = value_or_null(e->next, at, &r->corr_mesh, err);
     return rc;
 }
 
@@ -280,7 +286,7 @@ static int load_clip(const cJSON *row, const char *at, tcb_clip_record *r, tcb_e
 static int load_clips(const cJSON *root, const char *where, tcb_cell_result *c, tcb_error *err)
 {
     if (!cJSON_HasObjectItem(root, "clips")) return TCB_OK;
-    static const char *const columns[] = {"start", "corr", "err", NULL};
+    static const char *const columns[] = {"start", "corr", "err", "corr_mesh", NULL};
     char sub[TCB_ERRMSG_MAX];
     const cJSON *o, *cols, *rows;
     long long v;
@@ -293,10 +299,12 @@ static int load_clips(const cJSON *root, const char *where, tcb_cell_result *c, 
         (rc = tcb_json_int(o, "n_clips", sub, 1, 0, 1, INT_MAX, &v, err)))
         return rc;
     cols = cJSON_GetObjectItemCaseSensitive(o, "columns");
-    int k = 0, ok = cJSON_IsArray(cols) && cJSON_GetArraySize(cols) == 3;
+    int k = 0, n_cols = cJSON_GetArraySize(cols), ok = cJSON_IsArray(cols) && (n_cols == 3 || n_cols == 4);
     for (const cJSON *e = ok ? cols->child : NULL; e; e = e->next, k++)
         ok = ok && cJSON_IsString(e) && !strcmp(e->valuestring, columns[k]);
-    if (!ok) return tcb_fail(err, TCB_ERR_INPUT, "%s.columns: expected [\"start\", \"corr\", \"err\"]", sub);
+    if (!ok)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.columns: expected [\"start\", \"corr\", \"err\"] or with \"corr_mesh\"",
+                        sub);
     rows = cJSON_GetObjectItemCaseSensitive(o, "rows");
     if (!cJSON_IsArray(rows) || cJSON_GetArraySize(rows) != v)
         return tcb_fail(err, TCB_ERR_INPUT, "%s.rows: expected an array of n_clips (%lld) rows", sub, v);
@@ -307,7 +315,7 @@ static int load_clips(const cJSON *root, const char *where, tcb_cell_result *c, 
     for (const cJSON *row = rows->child; row && !rc; row = row->next, k++) {
         char at[TCB_ERRMSG_MAX];
         key_path(at, sizeof at, "%s.rows[%d]", sub, k);
-        rc = load_clip(row, at, &c->clips[k], err);
+        rc = load_clip(row, n_cols, at, &c->clips[k], err);
     }
     return rc;
 }
@@ -341,6 +349,10 @@ static int load_surface(const cJSON *root, const char *where, tcb_cell_result *c
     int rc = object_key(root, "surface", where, SURFACE_KEYS, &o, sub, sizeof sub, err);
     if (rc || (rc = tcb_json_int(o, "samples", sub, 1, 0, 1, INT_MAX, &v, err))) return rc;
     c->surface_samples = (int)v;
+    int frame;
+    if ((rc = tcb_json_enum(o, "frame", sub, 0, TCB_RECON_FRAME_SEQUENCE, tcb_recon_frame_names, &frame, err)))
+        return rc;
+    c->surface_frame = (tcb_recon_frame)frame;
     if (!surface_columns_ok(cJSON_GetObjectItemCaseSensitive(o, "columns")))
         return tcb_fail(err, TCB_ERR_INPUT, "%s.columns: expected [\"frame\", \"cdl2\", \"nc\", \"fscore05\", \"fscore1\"]",
                         sub);
@@ -451,12 +463,24 @@ static int load_plugin(const cJSON *root, const char *where, tcb_cell_result *c,
     return TCB_OK;
 }
 
+/* "normals", when the method took normals with its points (absent: none,
+ * or a cell written before the key). */
+static int load_normals(const cJSON *root, const char *where, tcb_cell_result *c, tcb_error *err)
+{
+    if (!cJSON_HasObjectItem(root, "normals")) return TCB_OK;
+    int idx;
+    int rc = tcb_json_enum(root, "normals", where, 1, 0, NORMALS_NAMES, &idx, err);
+    if (!rc) snprintf(c->normals, sizeof c->normals, "%s", NORMALS_NAMES[idx]);
+    return rc;
+}
+
 static int cell_from_json(const cJSON *root, const char *path, tcb_cell_result *c,
                           tcb_error *err)
 {
     int n_cols;
     int rc = tcb_json_expect_object(root, path, err);
     if (rc || (rc = load_header(root, path, c, err)) || (rc = load_plugin(root, path, c, err)) ||
+        (rc = load_normals(root, path, c, err)) ||
         (rc = load_params(root, path, c, err)) ||
         (rc = load_timings_split(root, path, c, err)) ||
         (rc = load_summary(root, path, &c->summary, err)) ||
@@ -473,6 +497,11 @@ static int cell_from_json(const cJSON *root, const char *path, tcb_cell_result *
     if ((c->status == TCB_CELL_OK || c->n_clips == 0) && c->summary.corr.n != c->n_clips)
         return tcb_fail(err, TCB_ERR_INPUT, "%s.summary.corr: %s, but the cell has %d clips", path,
                         c->summary.corr.n > 0 ? "over other clips" : "absent", c->n_clips);
+    int with_mesh = 0;
+    for (int k = 0; k < c->n_clips; k++) with_mesh += !isnan(c->clips[k].corr_mesh);
+    if (c->summary.corr_mesh.n != with_mesh)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.summary.corr_mesh: over %g clips, but %d clips have it", path,
+                        c->summary.corr_mesh.n, with_mesh);
     /* A finished ok cell scored every pair of its split. */
     if (c->status == TCB_CELL_OK && c->summary.n_pairs != c->n_pairs)
         return tcb_fail(err, TCB_ERR_INPUT, "%s.summary.n_pairs: %d, but the cell has %d pairs",

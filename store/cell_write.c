@@ -127,6 +127,7 @@ static void add_summary(builder *b, cJSON *root, const tcb_summary *s)
         append(b, geo_pck, num_or_null(s->geo_pck[k]));
     add_num(b, o, "geo_unreachable", s->geo_unreachable);
     if (s->corr.n > 0) add_stat(b, o, "corr", &s->corr);
+    if (s->corr_mesh.n > 0) add_stat(b, o, "corr_mesh", &s->corr_mesh);
     for (int m = 0; m < TCB_N_RECON; m++)
         if (s->recon[m].n > 0) add_stat(b, o, tcb_recon_names[m], &s->recon[m]);
 }
@@ -138,6 +139,8 @@ static void add_surface(builder *b, cJSON *root, const tcb_cell_result *c)
     cJSON *o = add(b, root, "surface", cJSON_CreateObject());
     if (!o) return;
     add_num(b, o, "samples", c->surface_samples);
+    if (c->surface_frame != TCB_RECON_FRAME_SEQUENCE)
+        add_str(b, o, "frame", tcb_recon_frame_names[c->surface_frame]);
     cJSON *cols = add(b, o, "columns", cJSON_CreateArray());
     append(b, cols, cJSON_CreateString("frame"));
     for (int m = 0; cols && m < TCB_N_RECON; m++) append(b, cols, cJSON_CreateString(tcb_recon_names[m]));
@@ -154,14 +157,17 @@ static void add_surface(builder *b, cJSON *root, const tcb_cell_result *c)
 static void add_clips(builder *b, cJSON *root, const tcb_cell_result *c)
 {
     if (c->n_clips == 0) return;
-    static const char *const columns[] = {"start", "corr", "err"};
+    static const char *const columns[] = {"start", "corr", "err", "corr_mesh"};
+    /* corr_mesh only when a clip has it, so that the cells of methods
+     * without surfaces read as they did before it. */
+    int mesh = c->summary.corr_mesh.n > 0;
     cJSON *o = add(b, root, "clips", cJSON_CreateObject());
     if (!o) return;
     add_str(b, o, "path", c->clips_path);
     add_num(b, o, "seed", (double)c->clips_seed);
     add_num(b, o, "clip_frames", TCB_CLIP_FRAMES);
     add_num(b, o, "n_clips", c->n_clips);
-    add(b, o, "columns", cJSON_CreateStringArray(columns, 3));
+    add(b, o, "columns", cJSON_CreateStringArray(columns, 3 + mesh));
     cJSON *rows = add(b, o, "rows", cJSON_CreateArray());
     for (int k = 0; rows && k < c->n_clips && b->ok; k++) {
         const tcb_clip_record *r = &c->clips[k];
@@ -172,6 +178,7 @@ static void add_clips(builder *b, cJSON *root, const tcb_cell_result *c)
         cJSON *err = cJSON_CreateArray();
         if (!append(b, row, err)) return;
         for (int t = 0; t < TCB_CLIP_FRAMES - 1; t++) append(b, err, num_or_null(r->err[t]));
+        if (mesh) append(b, row, num_or_null(r->corr_mesh));
     }
 }
 
@@ -289,6 +296,7 @@ cJSON *tcb_cell_to_json(const char *path, const tcb_cell_result *c, tcb_error *e
             add_str(&b, pl, "version", c->plugin_version);
         }
     }
+    if (c->normals[0]) add_str(&b, root, "normals", c->normals);
     add_summary(&b, root, &c->summary);
     add_pairs(&b, root, c);
     add_clips(&b, root, c);

@@ -78,7 +78,7 @@ int tcb_cell_session_open(const tcb_config *cfg, const char *run_dir, const tcb_
                           int threads, tcb_reporter reporter, tcb_cell_session *s, tcb_error *err)
 {
     memset(s, 0, sizeof *s);
-    int rc = tcb_harness_load_sequence(cfg, t->d, t->s->name, &reporter, &s->seq, err);
+    int rc = tcb_harness_load_sequence(cfg, t->d, t->s, &reporter, &s->seq, err);
     if (!rc) rc = tcb_harness_obtain_split(cfg, t->d, t->s, &s->seq, s->split_path,
                                            sizeof s->split_path, &s->split, err);
     if (!rc) rc = tcb_harness_work_paths(run_dir, t->d->name, t->s->name, t->m->label, t->seed,

@@ -60,6 +60,7 @@ extern "C" {
 enum {
     TCB_CMP_SL2, TCB_CMP_RANK, TCB_CMP_AUC, TCB_CMP_CD, TCB_CMP_GEO, TCB_CMP_GEO_AUC,
     TCB_CMP_CORR, /* per clip of the clip protocol, not per pair */
+    TCB_CMP_CORR_MESH, /* the same, DynoSurf's computation (methods with surfaces) */
     TCB_CMP_CDL2, TCB_CMP_NC, TCB_CMP_FSCORE05, TCB_CMP_FSCORE1, /* per evaluated frame */
     TCB_CMP_N_METRICS
 };

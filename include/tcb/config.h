@@ -28,12 +28,20 @@
  *                                        pairs (default), the 17-frame clips of DynoSurf/PDG/
  *                                        Neu-PiG (Corr; docs/protocol.md), or both
  *                     "clips": 10,       clips per sequence (clip protocol only)
+ *                     "fit": "sequence" | "per_clip",   one fit per sequence (default), or
+ *                                        each clip fitted as a sequence of its own, in its own
+ *                                        frame (the 2024-2026 papers; clip protocol only)
+ *                     "input_normals": "none" | "gt" | "estimated",   normals with the
+ *                                        input clouds, for methods that take them
+ *                     "recon_frame": "sequence" | "frame_box",   the frame of the
+ *                                        reconstruction metrics: the sequence's normalized
+ *                                        one, or each frame's GT box (Neu-PiG's evaluation)
  *                     "surface_samples": 100000 },   samples per mesh of the
  *                                        reconstruction metrics (CD-L2, NC, F-score)
  *                                        of the methods that give surfaces
  *     "datasets": [
  *       { "name": "synth", "source": "synthetic", "seed": 0, "frames": 0,
- *         "normalization": "first_frame" | "none" | "per_frame",
+ *         "normalization": "first_frame" | "none" | "per_frame" | "clip_bbox" | "first_frame_diag",
  *         "align_rotation": false,       yaw-align each frame to the previous (AMA; tcb/align.h)
  *         "align_samples": 1000,         vertices the alignment's Chamfer runs on
  *         "sampling": "without_replacement" | "with_replacement",
@@ -42,6 +50,11 @@
  *                                        left out and given as --root NAME=DIR or in the
  *                                        environment as TCBENCH_ROOT_<NAME>
  *         "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] },
+ *         under "fit": "per_clip" a sequence entry may list its clips' first frames:
+ *           { "name": "crane", "role": "validation", "clip_starts": [10, 27] }
+ *         which stands for the sequences crane_0010 and crane_0027, each written
+ *           { "name": "crane_0010", "role": "validation", "clip_of": "crane", "start": 10 };
+ *         an entry without either is one clip itself (exactly 17 frames)
  *       { "name": "dfaust", "source": "dfaust", tcb/dfaust.h: one block of frames per subject
  *         "root": "../shared/data/dfaust", holds registrations_m.hdf5 and/or _f.hdf5
  *         "subjects": ["50002", "50004"],  default: every subject that has the sequence
@@ -66,6 +79,7 @@
 
 #include "tcb/error.h"
 #include "tcb/fsutil.h"
+#include "tcb/metrics.h"
 #include "tcb/sequence.h"
 #include "tcb/split.h"
 
@@ -78,6 +92,12 @@ typedef enum tcb_source { TCB_SOURCE_SYNTHETIC, TCB_SOURCE_OBJDIR, TCB_SOURCE_DF
 typedef struct tcb_sequence_spec {
     char name[TCB_NAME_MAX];
     tcb_role role;
+    /* A clip fitted on its own ("evaluation.fit": "per_clip"): frames
+     * start .. start + TCB_CLIP_FRAMES - 1 of the dataset's sequence
+     * clip_of, as a sequence of its own named `name` ("crane_0010");
+     * clip_of is "" for a whole sequence. */
+    char clip_of[TCB_NAME_MAX];
+    int start;
 } tcb_sequence_spec;
 
 typedef struct tcb_dataset_spec {
@@ -131,6 +151,10 @@ typedef struct tcb_config {
     int eval_pairs;
     uint64_t split_seed;
     int protocols;           /* TCB_PROTOCOL_* bits, never 0 */
+    int fit_per_clip;        /* "fit": "per_clip": every sequence of the grid is one clip,
+                              * fitted on its own (clip protocol only) */
+    tcb_input_normals input_normals; /* the normals input clouds come with */
+    tcb_recon_frame recon_frame;     /* the frame of the reconstruction metrics */
     int eval_clips;          /* clips per sequence under the clip protocol */
     int surface_samples;     /* samples per mesh of the reconstruction metrics */
     int pool_size;
@@ -181,6 +205,8 @@ extern const char *const tcb_config_source_names[];   /* tcb_source */
 extern const char *const tcb_config_norm_names[];     /* tcb_normalization */
 extern const char *const tcb_config_protocol_names[]; /* by TCB_PROTOCOL_* bit position */
 extern const char *const tcb_config_sampling_names[]; /* with_replacement: 0, 1 */
+extern const char *const tcb_config_fit_names[];      /* fit_per_clip: 0, 1 */
+extern const char *const tcb_config_input_normals_names[]; /* tcb_input_normals */
 
 /* The config with every default filled in, pretty-printed (what a run
  * directory records of it); malloc'ed, NULL

@@ -44,11 +44,12 @@ extern "C" {
  * that declines (TCB_ERR_UNSUPPORTED), 5 `presets`, `train_steps` and the
  * estimate priced by calibrated costs (tcb_cost_estimate.steps, .preset),
  * 6 `units`, `run_unit`, the estimate's unit counts (.units, .n_units) and
- * steps that grow with the frame count (.step_frames), 7 `version`; tables
+ * steps that grow with the frame count (.step_frames), 7 `version`, 8
+ * `normals` and the sequence's input normals (tcb_sequence.input_normals); tables
  * of older versions still load, and the harness reads no member their
  * version did not have (their tables end before it; the estimate it
  * zeroes). */
-#define TCB_METHOD_ABI_VERSION 7
+#define TCB_METHOD_ABI_VERSION 8
 #define TCB_METHOD_ABI_OLDEST 1
 
 typedef struct tcb_fit_ctx {
@@ -252,12 +253,27 @@ typedef struct tcb_method_ops {
      * traced to the code that made it. A built-in method's is tcbench's
      * (the cell's git_revision). */
     const char *version;
+
+    /* Optional (NULL: the method takes points only; read only from tables
+     * of abi_version >= 8). The normals a created method uses with its
+     * input points on seq: "gt", "estimated" (from the sequence's input
+     * normals, tcb_sequence.input_normals, or estimated by the method
+     * itself when the sequence gives none), "" none; a static string.
+     * Recorded in the cell, so a table says which methods had normals. */
+    const char *(*normals)(void *self, const tcb_sequence *seq);
 } tcb_method_ops;
 
 /* The method's version string (tcb_method_ops.version); "" when none. */
 static inline const char *tcb_method_version(const tcb_method_ops *ops)
 {
     return ops->abi_version >= 7 && ops->version ? ops->version : "";
+}
+
+/* The normals the method uses on seq (tcb_method_ops.normals); "" none. */
+static inline const char *tcb_method_normals(const tcb_method_ops *ops, void *self, const tcb_sequence *seq)
+{
+    const char *n = ops->abi_version >= 8 && ops->normals ? ops->normals(self, seq) : NULL;
+    return n ? n : "";
 }
 
 /* The method of ops gives a surface per frame (tcb_method_ops.surface). */

@@ -113,6 +113,20 @@ enum { TCB_RECON_CDL2, TCB_RECON_NC, TCB_RECON_FSCORE05, TCB_RECON_FSCORE1, TCB_
 #define TCB_FSCORE_T1 0.01
 #define TCB_DEFAULT_SURFACE_SAMPLES 100000
 
+/* The frame the reconstruction metrics are measured in: the sequence's
+ * (its normalization), or each frame's own GT box: centred on the box's
+ * centre, its largest extent 1 (Neu-PiG's evaluation, after Occupancy
+ * Networks'; the F-score thresholds are then 0.5 % and 1 % of it). */
+typedef enum tcb_recon_frame { TCB_RECON_FRAME_SEQUENCE = 0, TCB_RECON_FRAME_BOX = 1 } tcb_recon_frame;
+extern const char *const tcb_recon_frame_names[]; /* "sequence", "frame_box"; NULL-terminated */
+
+/* The map of TCB_RECON_FRAME_BOX for a frame of n GT vertices [n][3]:
+ * x -> (x - centre) * scale, scale = 1 / the box's largest extent (0 for
+ * a frame of no extent). */
+void tcb_frame_box_map(const float *gt, int n, double centre[3], double *scale);
+/* pts[n][3] mapped in place. */
+void tcb_frame_box_apply(const double centre[3], double scale, float *pts, int n);
+
 /* "cdl2", "nc", "fscore05", "fscore1": the cell's keys, in enum order. */
 extern const char *const tcb_recon_names[TCB_N_RECON];
 
@@ -144,6 +158,10 @@ typedef struct tcb_summary {
      * a clip's frames 1-16), over clips; n = 0 when no clip was scored (a
      * pairs-only run, an older cell). */
     tcb_stat corr;
+    /* DynoSurf's Corr as its evaluation computes it (tcb_corr_mesh_match),
+     * over the clips of a method whose surfaces share one topology
+     * through the clip; n = 0 otherwise (or an older cell). */
+    tcb_stat corr_mesh;
     /* The reconstruction metrics (TCB_RECON_*), over the cell's evaluated
      * frames; n = 0 when the method gives no surface (or an older cell). */
     tcb_stat recon[TCB_N_RECON];
@@ -156,6 +174,15 @@ typedef struct tcb_summary {
  * frame t, summed in double. Corr of a clip is the mean of this over
  * t = 1 .. 16 (docs/protocol.md, "The clip protocol"). */
 double tcb_corr_frame(const float *moved, const float *truth, int n);
+
+/* DynoSurf's Corr of a clip of surfaces with one topology (its
+ * evaluation/utils.py, eval_correspondences_mesh): each vertex i of the
+ * method's frame-0 surface is matched to its nearest GT point of frame 0,
+ * ind[i] (pred0 [n][3], gt0 [ng][3]); at frame t the error is then the
+ * mean over i of |pred_t[i] - gt_t[ind[i]]| (tcb_corr_mesh_frame), and
+ * the clip's value their mean over t = 1 .. 16. */
+int tcb_corr_mesh_match(const float *pred0, int n, const float *gt0, int ng, int32_t *ind, tcb_error *err);
+double tcb_corr_mesh_frame(const float *pred_t, int n, const float *gt_t, const int32_t *ind);
 
 void tcb_summary_init(tcb_summary *s);
 /* cd: the pair's Chamfer distance, or NAN when there is none. */

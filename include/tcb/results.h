@@ -57,11 +57,13 @@
  * digest, the table's abi_version and version string, "" when it has
  * none); a built-in method's cell, and one written before the key, has
  * none (plugin_path "").
+ * A cell whose method took normals with its input points says which:
+ * "normals": "gt" | "estimated" (absent: points only, or written before).
  * The reconstruction metrics (tcb/metrics.h, TCB_RECON_*; docs/protocol.md,
  * "Reconstruction metrics") came later too: a cell whose method gives
  * surfaces has "summary.cdl2", "summary.nc", "summary.fscore05" and
  * "summary.fscore1" ({n, mean, m2} over its evaluated frames) and
- *     "surface": {"samples": 100000,
+ *     "surface": {"samples": 100000, "frame": "frame_box" (absent: "sequence"),
  *                 "columns": ["frame", "cdl2", "nc", "fscore05", "fscore1"],
  *                 "rows": [[frame, cdl2, nc, fscore05, fscore1], …]}
  * one row per evaluated frame (every frame of its pairs and clips, once,
@@ -106,6 +108,8 @@ typedef struct tcb_clip_record {
     int start;                          /* the clip's frame 0 */
     double corr;                        /* mean of err */
     double err[TCB_CLIP_FRAMES - 1];    /* tcb_corr_frame at the clip's frames 1 .. 16 */
+    double corr_mesh;                   /* DynoSurf's Corr (tcb_corr_mesh_match); NAN: the method's
+                                         * surfaces are not of one topology, or it has none */
 } tcb_clip_record;
 
 typedef struct tcb_cell_result {
@@ -118,6 +122,8 @@ typedef struct tcb_cell_result {
     char plugin_digest[17];    /* and the file's FNV-1a 64 (hex) when the cell ran */
     int plugin_abi;            /* and its table's abi_version */
     char plugin_version[64];   /* and its version string (tcb_method_ops.version; "" none) */
+    char normals[16];          /* the normals the method took with its input points
+                                * (tcb_method_normals: "gt", "estimated"); "" none */
     char *params_json;         /* malloc'ed, compact JSON object */
     int seed;
     tcb_cell_status status;
@@ -140,6 +146,7 @@ typedef struct tcb_cell_result {
     /* The reconstruction metrics per evaluated frame; n_surface = 0: none
      * (a method without surfaces, an older cell; summary.recon[].n 0). */
     int surface_samples;       /* samples per mesh */
+    tcb_recon_frame surface_frame; /* the frame they were measured in */
     int n_surface;
     tcb_surface_record *surface; /* malloc'ed [n_surface], ascending frame */
 } tcb_cell_result;

@@ -32,8 +32,22 @@ extern "C" {
 typedef enum tcb_normalization {
     TCB_NORM_NONE = 0,        /* raw coordinates (DFAUST) */
     TCB_NORM_FIRST_FRAME = 1, /* ANIM: centre on frame 0's vertex centroid, divide by its largest bbox extent */
-    TCB_NORM_PER_FRAME = 2    /* AMA-like: each frame centred on its own surface centroid, no scaling */
+    TCB_NORM_PER_FRAME = 2,   /* AMA-like: each frame centred on its own surface centroid, no scaling */
+    TCB_NORM_CLIP_BBOX = 3,   /* Neu-PiG, PDG: centre of the box of every frame's vertices, divided by
+                               * half its largest extent, times 0.95 (their src/io/) */
+    TCB_NORM_FIRST_FRAME_DIAG = 4 /* DynoSurf: frame 0's vertex mean subtracted, divided by the
+                                   * diagonal of frame 0's bounding box (its code/dataset.py) */
 } tcb_normalization;
+
+/* The margin of TCB_NORM_CLIP_BBOX: the sequence fills 95 % of [-1, 1]³. */
+#define TCB_CLIP_BBOX_MARGIN 0.95
+
+/* The normals that come with a method's input clouds ("evaluation.input_normals"). */
+typedef enum tcb_input_normals {
+    TCB_INPUT_NORMALS_NONE = 0,     /* points only (the ICCV'21 protocol) */
+    TCB_INPUT_NORMALS_GT = 1,       /* the unit normal of the GT face each point was sampled on */
+    TCB_INPUT_NORMALS_ESTIMATED = 2 /* estimated from the cloud alone (PCA, oriented) */
+} tcb_input_normals;
 
 typedef struct tcb_sequence {
     char name[TCB_NAME_MAX];
@@ -46,7 +60,7 @@ typedef struct tcb_sequence {
     int pool_size;      /* samples per frame; 0 until pools are drawn */
     float *pools;       /* [n_frames][pool_size][3] area-uniform samples */
     tcb_normalization norm;
-    double norm_scale;  /* FIRST_FRAME: the divisor; 1 otherwise */
+    double norm_scale;  /* FIRST_FRAME, CLIP_BBOX, FIRST_FRAME_DIAG: the divisor; 1 otherwise */
     double *norm_shift; /* [n_frames][3] subtracted before scaling */
     double *yaw;        /* [n_frames] radians about y applied after the normalization
                          * (rotation alignment, tcb/align.h); NULL when not aligned */
@@ -57,6 +71,11 @@ typedef struct tcb_sequence {
     int draw_with_replacement;
     int n_blocks;       /* 0: one block, the whole sequence (every source but DFAUST) */
     tcb_block *blocks;  /* [n_blocks], tiling [0, n_frames) in order */
+    /* Appended last (plug-ins built before it never read it): the normals
+     * that come with input clouds, set by the harness from the config; a
+     * method that takes normals gets them with tcb_sequence_input_normals
+     * (tcb/input_normals.h). */
+    tcb_input_normals input_normals;
 } tcb_sequence;
 
 static inline const float *tcb_seq_frame(const tcb_sequence *s, int f)
@@ -105,6 +124,13 @@ int tcb_sequence_draw_points(const tcb_sequence *s, int f, int n, int with_repla
  * vertices, faces, pools, block starts): what files saved for one cell
  * record, so that another sequence's are refused (datasets/fingerprint.c). */
 uint64_t tcb_sequence_fingerprint(const tcb_sequence *s);
+
+/* Frames start .. start + n_frames - 1 of `from` (raw: before any
+ * normalization or pools) as a new sequence named `name`, all in one of
+ * from's blocks (an error naming the block otherwise); the copy has no
+ * blocks, pools or normalization yet (tcb_sequence_prepare). */
+int tcb_sequence_cut(const tcb_sequence *from, int start, int n_frames, const char *name, tcb_sequence *out,
+                     tcb_error *err);
 
 /* Write every frame as <dir>/mesh_NNNN.obj (atomically, one file each). */
 int tcb_sequence_write_objdir(const tcb_sequence *s, const char *dir, tcb_error *err);

@@ -11,9 +11,10 @@
  *            depth 10, the reference's network), fast (the paper's
  *            250-epoch variant), cpu (the paper's 1 000 epochs at sizes
  *            for 2 cores: docs/protocol.md, "Neu-PiG"), tiny (tests)
- *   normals  estimated (default: PCA, oriented; tcbench's methods see
- *            points only) | gt (the reference's setting: the ground-truth
- *            face normal at each keyframe point)
+ *   normals  input (default: the normals the sequence's input comes with,
+ *            "evaluation.input_normals", estimated when it comes with none)
+ *            | estimated (PCA, oriented) | gt (the reference's setting:
+ *            the ground-truth face normal at each keyframe point)
  *   epochs, points, template_faces, poisson_depth, levels, features,
  *   hidden, recon_points, checkpoint_every, divergence
  *
@@ -62,7 +63,8 @@ static const neupig_preset presets[] = {
     {30, 300, 400, 6, 3, 8, 16},         /* tiny */
 };
 static const char *const preset_names[] = {"paper", "fast", "cpu", "tiny", NULL};
-static const char *const normals_names[] = {"estimated", "gt", NULL};
+static const char *const normals_names[] = {"estimated", "gt", "input", NULL};
+enum { NORMALS_ESTIMATED, NORMALS_GT, NORMALS_INPUT };
 /* The presets `tcbench calibrate` measures: fast has paper's sizes (its
  * epochs cost what paper's do), so paper's step prices it. */
 static const char *const calibrated_presets[] = {"paper", "cpu", "tiny", NULL};
@@ -75,7 +77,9 @@ struct steps;
 typedef struct neupig_method {
     tcb_neupig_arch arch;
     tcb_neupig_schedule sched;
-    int points, template_faces, poisson_depth, gt_normals, recon_points;
+    int points, template_faces, poisson_depth, recon_points;
+    int normals;                   /* NORMALS_*: the "normals" param */
+    int gt_normals;                /* the keyframe's normals are GT's: resolved on the sequence */
     long long checkpoint_every;
     uint64_t seed;
     /* The fitted model (after fit or load). */
@@ -97,10 +101,10 @@ static int parse(const char *params_json, void *obj, tcb_error *err)
     cJSON *j;
     int rc = tcb_params_parse(params_json, where, keys, &j, err);
     if (rc) return rc;
-    int pi = 2, ni = 0;
+    int pi = 2, ni = NORMALS_INPUT;
     long long epochs, points, faces, depth, levels, features, hidden, recon;
     rc = tcb_json_enum(j, "preset", where, 0, 2, preset_names, &pi, err);
-    if (!rc) rc = tcb_json_enum(j, "normals", where, 0, 0, normals_names, &ni, err);
+    if (!rc) rc = tcb_json_enum(j, "normals", where, 0, NORMALS_INPUT, normals_names, &ni, err);
     const neupig_preset *p = &presets[pi];
     if (!rc) rc = tcb_json_int(j, "epochs", where, 0, p->epochs, 1, 100000000, &epochs, err);
     if (!rc) rc = tcb_json_int(j, "points", where, 0, p->points, 4, 10000000, &points, err);
@@ -119,7 +123,7 @@ static int parse(const char *params_json, void *obj, tcb_error *err)
     m->arch.levels = (int)levels, m->arch.features = (int)features, m->arch.hidden = (int)hidden;
     m->sched.epochs = epochs, m->sched.lr_grid = 0.005, m->sched.lr_growth = 2.5, m->sched.lr_mlp = 1e-3;
     m->points = (int)points, m->template_faces = (int)faces, m->poisson_depth = (int)depth;
-    m->gt_normals = ni == 1, m->recon_points = (int)recon;
+    m->normals = ni, m->recon_points = (int)recon;
     return TCB_OK;
 }
 
@@ -193,10 +197,23 @@ static int draw_clouds(neupig_method *m, const tcb_sequence *seq, uint64_t seed,
     return rc;
 }
 
+/* Whether the keyframe's normals are GT's on seq: the "normals" param, or
+ * under "input" the sequence's input normals. */
+static int uses_gt_normals(const neupig_method *m, const tcb_sequence *seq)
+{
+    return m->normals == NORMALS_GT || (m->normals == NORMALS_INPUT && seq->input_normals == TCB_INPUT_NORMALS_GT);
+}
+
+static const char *normals_used(void *self, const tcb_sequence *seq)
+{
+    return uses_gt_normals(self, seq) ? "gt" : "estimated";
+}
+
 static int prepare(neupig_method *m, const tcb_sequence *seq, uint64_t seed, inputs *in, tcb_error *err)
 {
     memset(in, 0, sizeof *in);
     tcb_mesh_free(&m->template_mesh);
+    m->gt_normals = uses_gt_normals(m, seq);
     int rc = draw_clouds(m, seq, seed, in, err);
     if (!rc)
         rc = tcb_neupig_keyframe((const float *const *)in->clouds, in->n, in->T, TCB_NEUPIG_KEYFRAME_RES, &in->key, err);
@@ -410,6 +427,7 @@ static int load(void *self, const tcb_sequence *seq, const char *path, tcb_error
     size_t n = n_params_of(m, err);
     if (!n) return err->code;
     if (!(m->params = malloc(n * sizeof *m->params))) return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    m->gt_normals = uses_gt_normals(m, seq);
     cJSON *want = manifest(m, n);
     tcb_weight_parts w = {1, {m->params, NULL}, {n, 0}};
     uint64_t seed = 0;
@@ -540,4 +558,5 @@ const tcb_method_ops tcb_method_neupig = {
     .train_steps = train_steps,
     .units = unit_names,
     .run_unit = run_unit,
+    .normals = normals_used,
 };

@@ -320,7 +320,7 @@ static void test_md_per_seed_table(void **state)
 
 /* ------------------------------------------------------------------ CSV */
 
-#define CSV_MAX_FIELDS 43
+#define CSV_MAX_FIELDS 46
 typedef struct csv_row {
     char field[CSV_MAX_FIELDS][64];
 } csv_row;
@@ -390,7 +390,7 @@ static void test_csv_parses_back(void **state)
 {
     fixture *f = *state;
     int n;
-    csv_row *rows = read_csv(f, "results.csv", 43, &n);
+    csv_row *rows = read_csv(f, "results.csv", 46, &n);
     /* header + 4 sequences × 3 methods + anim's 3 MEAN rows */
     assert_int_equal(n, 1 + 12 + 3);
     /* where the columns are: every addition at the end (Corr before the
@@ -399,7 +399,7 @@ static void test_csv_parses_back(void **state)
         {7, "sl2_x1e3_mean"},   {15, "sl2sq_x1e3_mean"},  {17, "geo_x1e3_mean"},   {21, "geo_unreachable"},
         {22, "corr_x1e3_mean"}, {24, "sl2_mark"},         {30, "corr_mark"},       {31, "cdl2_x1e3_mean"},
         {33, "nc_pct_mean"},    {35, "fscore05_pct_mean"}, {37, "fscore1_pct_mean"}, {39, "cdl2_mark"},
-        {42, "fscore1_mark"}};
+        {42, "fscore1_mark"},     {43, "corr_mesh_x1e3_mean"}, {45, "corr_mesh_mark"}};
     for (size_t k = 0; k < sizeof cols / sizeof *cols; k++) assert_string_equal(rows[0].field[cols[k].at], cols[k].name);
     expect an = expected(1, 0), nn = expected(1, 1);
     const csv_row *r = find_csv(rows, n, "horse", "AN");
@@ -487,9 +487,10 @@ static void test_seed_csv_one_row_per_cell(void **state)
 {
     fixture *f = *state;
     int n;
-    csv_row *rows = read_csv(f, "seeds.csv", 18, &n);
+    csv_row *rows = read_csv(f, "seeds.csv", 19, &n);
     assert_string_equal(rows[0].field[14], "cdl2_x1e3_mean");
     assert_string_equal(rows[0].field[17], "fscore1_pct_mean");
+    assert_string_equal(rows[0].field[18], "corr_mesh_x1e3_mean");
     assert_string_equal(rows[0].field[4], "seed");
     int n_cells = 0;
     for (int m = 0; m < N_METHODS; m++) n_cells += N_SEQS * METHODS[m].n_seeds;
@@ -538,9 +539,9 @@ static void test_tex_uses_booktabs(void **state)
     assert_contains(tex, "\\midrule");
     assert_contains(tex, "\\bottomrule");
     assert_contains(tex, "m\\_sL2 $\\downarrow$");
-    assert_contains(tex, "m\\_geo $\\downarrow$ & AUC\\_geo $\\uparrow$ & Corr $\\downarrow$ & CD-L2 $\\downarrow$ & NC "
-                         "$\\uparrow$ & F@0.5\\% $\\uparrow$ & F@1\\% $\\uparrow$ \\\\");
-    assert_contains(tex, "\\begin{tabular}{llccccccccccc}");
+    /* no cell scored clips or has surfaces: no Corr, Corr-mesh, CD-L2, NC, F columns */
+    assert_contains(tex, "m\\_geo $\\downarrow$ & AUC\\_geo $\\uparrow$ \\\\");
+    assert_contains(tex, "\\begin{tabular}{llcccccc}");
     /* DSR leads, tied for best (2 pairs: nothing can be significant) */
     expect dsr = expected(1, 2);
     char tied[128];
@@ -631,15 +632,14 @@ static void test_old_cells_show_dash(void **state)
     char *old = md_line(md, "OLD (seed 0)"), *neu = md_line(md, "NEW (seed 0)"), *mix = md_line(md, "MIX");
     /* OLD: leads on the paper's m_sL2 (tied for best: 2 pairs cannot make it
      * significant), "-" for the geodesic error */
-    /* (the last five columns, Corr and the reconstruction metrics: "-" in
-     * every row, no cell has clips or surfaces) */
-    const char *none5 = " | - | - | - | - | - |", *none6 = "| - | - | - | - | - | - |";
-    if (strncmp(old, "| OLD (seed 0) | ", 17) || !strstr(old, " ≈ |") || !ends_with(old, none6)) fail_msg("%s", old);
-    if (!ends_with(mix, none6)) fail_msg("%s", mix);
-    /* NEW alone has geodesic numbers, with nothing to compare: not marked;
-     * no cell scored clips: "-" under Corr (the last column) */
-    if (!ends_with(neu, none5) || strstr(neu, none6) || strstr(neu, "** | - |") || strstr(neu, "≈ | - |"))
-        fail_msg("%s", neu);
+    /* (no Corr or reconstruction columns: no cell has clips or surfaces;
+     * the geodesic error's two last) */
+    const char *none2 = "| - | - |";
+    if (strncmp(old, "| OLD (seed 0) | ", 17) || !strstr(old, " ≈ |") || !ends_with(old, none2)) fail_msg("%s", old);
+    if (!ends_with(mix, none2)) fail_msg("%s", mix);
+    if (strstr(md, "Corr ↓") || strstr(md, "CD-L2 ↓")) fail_msg("columns no cell has are shown");
+    /* NEW alone has geodesic numbers, with nothing to compare: not marked */
+    if (ends_with(neu, " - |") || strstr(neu, "**") || strstr(neu, "≈ | - |")) fail_msg("%s", neu);
     snprintf(path, sizeof path, "%s/report/pck_geo_anim_horse.png", dir);
     assert_true(tcb_is_file(path));
     free(old), free(neu), free(mix), free(md);

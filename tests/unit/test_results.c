@@ -112,6 +112,9 @@ static void assert_cells_equal(const tcb_cell_result *a, const tcb_cell_result *
     assert_memory_equal(s->geo_pck, t->geo_pck, sizeof s->geo_pck);
     assert_true(s->geo_unreachable == t->geo_unreachable);
     assert_stat_equal(&s->corr, &t->corr);
+    assert_stat_equal(&s->corr_mesh, &t->corr_mesh);
+    assert_string_equal(a->normals, b->normals);
+    assert_int_equal(a->n_surface ? a->surface_frame : 0, b->n_surface ? b->surface_frame : 0);
     assert_int_equal(a->n_clips, b->n_clips);
     assert_string_equal(a->clips_path, b->clips_path);
     assert_true(a->clips_seed == b->clips_seed);
@@ -126,6 +129,8 @@ static void assert_cells_equal(const tcb_cell_result *a, const tcb_cell_result *
 static void add_surface(tcb_cell_result *c, tcb_surface_record *rows)
 {
     c->surface_samples = 1000;
+    c->surface_frame = TCB_RECON_FRAME_BOX;
+    snprintf(c->normals, sizeof c->normals, "gt");
     c->n_surface = 3;
     c->surface = rows;
     for (int k = 0; k < 3; k++) {
@@ -140,7 +145,8 @@ static void add_surface(tcb_cell_result *c, tcb_surface_record *rows)
 /* What a test cell carries besides the pairs. */
 enum { WITH_CLIPS = 1, WITH_SURFACE = 2 };
 
-/* Two clips of the clip protocol into c (records in clips[2]). */
+/* Two clips of the clip protocol into c (records in clips[2]); the first
+ * has DynoSurf's Corr too, the second none (a null in its row). */
 static void add_clips(tcb_cell_result *c, tcb_clip_record *clips)
 {
     snprintf(c->clips_path, sizeof c->clips_path, "splits/%s/%s.clips.json", c->dataset, c->sequence);
@@ -155,7 +161,9 @@ static void add_clips(tcb_cell_result *c, tcb_clip_record *clips)
             clips[k].corr += clips[k].err[t] / (TCB_CLIP_FRAMES - 1);
         }
         tcb_stat_push(&c->summary.corr, clips[k].corr);
+        clips[k].corr_mesh = k == 0 ? 1.25 * clips[k].corr : NAN;
     }
+    tcb_stat_push(&c->summary.corr_mesh, clips[0].corr_mesh);
 }
 
 static void round_trip(int with_cd, int with)
