@@ -12,28 +12,19 @@
 #include "harness/harness_internal.h"
 #include "scoring/scoring.h"
 
-/* Scratch for one frame: the two sample sets and their normals, and the
- * frame's GT vertices in the frame the metrics are measured in. */
-typedef struct samples {
-    int n;
-    float *pred, *pred_n, *gt, *gt_n; /* [n][3] each */
-    float *gt_verts;                  /* [n_verts][3] */
-    double centre[3], scale;          /* TCB_RECON_FRAME_BOX: the frame's map */
-} samples;
-
-static void samples_free(samples *s)
+void tcb_surface_samples_free(tcb_surface_samples *s)
 {
     free(s->pred), free(s->pred_n), free(s->gt), free(s->gt_n), free(s->gt_verts);
     memset(s, 0, sizeof *s);
 }
 
-static int samples_init(samples *s, int n, int n_verts, tcb_error *herr)
+int tcb_surface_samples_init(tcb_surface_samples *s, int n, int n_verts, tcb_error *herr)
 {
     size_t bytes = (size_t)n * 3 * sizeof(float);
-    *s = (samples){n, malloc(bytes), malloc(bytes), malloc(bytes), malloc(bytes),
-                   malloc((size_t)n_verts * 3 * sizeof(float)), {0, 0, 0}, 1.0};
+    *s = (tcb_surface_samples){n, malloc(bytes), malloc(bytes), malloc(bytes), malloc(bytes),
+                               malloc((size_t)n_verts * 3 * sizeof(float)), {0, 0, 0}, 1.0};
     if (s->pred && s->pred_n && s->gt && s->gt_n && s->gt_verts) return TCB_OK;
-    samples_free(s);
+    tcb_surface_samples_free(s);
     return tcb_fail(herr, TCB_ERR_NOMEM, "out of memory for %d surface samples", n);
 }
 
@@ -61,7 +52,7 @@ int tcb_cell_method_surface(const tcb_cell_job *job, void *self, int frame, tcb_
 
 /* The method's surface of `frame`, sampled into s->pred / s->pred_n; its
  * failures (a bad mesh, one of no area) are the method's. */
-static int method_samples(const tcb_cell_job *job, void *self, int frame, samples *s, tcb_error *merr)
+static int method_samples(const tcb_cell_job *job, void *self, int frame, tcb_surface_samples *s, tcb_error *merr)
 {
     tcb_rng rng;
     tcb_uv_mesh m;
@@ -75,7 +66,7 @@ static int method_samples(const tcb_cell_job *job, void *self, int frame, sample
 
 /* The frame's GT vertices in the metrics' frame into s->gt_verts, and
  * under TCB_RECON_FRAME_BOX the map the method's surface gets too. */
-static void gt_frame(const tcb_cell_job *job, int frame, samples *s)
+static void gt_frame(const tcb_cell_job *job, int frame, tcb_surface_samples *s)
 {
     const tcb_sequence *seq = job->seq;
     memcpy(s->gt_verts, tcb_seq_frame(seq, frame), (size_t)seq->n_verts * 3 * sizeof(float));
@@ -84,18 +75,24 @@ static void gt_frame(const tcb_cell_job *job, int frame, samples *s)
     tcb_frame_box_apply(s->centre, s->scale, s->gt_verts, seq->n_verts);
 }
 
-static int frame_metrics(const tcb_cell_job *job, void *self, int frame, samples *s, tcb_surface_record *rec,
-                         tcb_error *merr, tcb_error *herr)
+int tcb_cell_surface_samples(const tcb_cell_job *job, void *self, int frame, tcb_surface_samples *s,
+                             tcb_error *merr, tcb_error *herr)
 {
     const tcb_sequence *seq = job->seq;
     gt_frame(job, frame, s);
     if (method_samples(job, self, frame, s, merr)) return merr->code;
     tcb_rng rng;
     frame_stream(job, "surface_gt", frame, &rng);
+    return tcb_recon_sample(s->gt_verts, seq->faces, seq->n_faces, s->n, &rng, s->gt, s->gt_n, herr);
+}
+
+static int frame_metrics(const tcb_cell_job *job, void *self, int frame, tcb_surface_samples *s,
+                         tcb_surface_record *rec, tcb_error *merr, tcb_error *herr)
+{
     rec->frame = frame;
-    int rc = tcb_recon_sample(s->gt_verts, seq->faces, seq->n_faces, s->n, &rng, s->gt, s->gt_n, herr);
+    int rc = tcb_cell_surface_samples(job, self, frame, s, merr, herr);
     if (!rc) rc = tcb_recon_metrics(s->pred, s->pred_n, s->n, s->gt, s->gt_n, s->n, rec->v, herr);
-    if (rc) tcb_error_prefix(herr, "surface metrics of frame %d: ", frame);
+    if (rc && herr->code) tcb_error_prefix(herr, "surface metrics of frame %d: ", frame);
     return rc;
 }
 
@@ -126,8 +123,8 @@ void tcb_cell_surface_metrics(const tcb_cell_job *job, void *self, tcb_cell_resu
 {
     if (job->surface_samples <= 0 || !tcb_method_has_surface(job->ops)) return;
     unsigned char *used = calloc((size_t)job->seq->n_frames, 1);
-    samples s = {0};
-    if (!used || samples_init(&s, job->surface_samples, job->seq->n_verts, herr)) {
+    tcb_surface_samples s = {0};
+    if (!used || tcb_surface_samples_init(&s, job->surface_samples, job->seq->n_verts, herr)) {
         free(used);
         if (!herr->code) tcb_fail(herr, TCB_ERR_NOMEM, "out of memory for %d frames", job->seq->n_frames);
         return;
@@ -144,5 +141,5 @@ void tcb_cell_surface_metrics(const tcb_cell_job *job, void *self, tcb_cell_resu
     c->surface_samples = job->surface_samples;
     c->surface_frame = job->recon_frame;
     free(used);
-    samples_free(&s);
+    tcb_surface_samples_free(&s);
 }

@@ -150,6 +150,24 @@ int tcb_cell_method_surface(const tcb_cell_job *job, void *self, int frame, tcb_
 void tcb_cell_corr_mesh(const tcb_cell_job *job, void *self, int c, tcb_clip_record *rec, tcb_error *merr,
                         tcb_error *herr);
 
+/* The two sample sets the reconstruction metrics of one frame score: the
+ * method's surface and the GT mesh, in the frame job->recon_frame names
+ * (gt_verts the GT frame's vertices in it; centre and scale the frame
+ * box's map, identity otherwise), n samples each with unit normals. */
+typedef struct tcb_surface_samples {
+    int n;
+    float *pred, *pred_n, *gt, *gt_n; /* [n][3] each */
+    float *gt_verts;                  /* [n_verts][3] */
+    double centre[3], scale;
+} tcb_surface_samples;
+int tcb_surface_samples_init(tcb_surface_samples *s, int n, int n_verts, tcb_error *herr);
+void tcb_surface_samples_free(tcb_surface_samples *s);
+/* Frame `frame`'s sample sets into s (sized by tcb_surface_samples_init):
+ * the method's from the stream "surface/<dataset>/<sequence>/<frame>",
+ * the GT's from "surface_gt/…" (harness/cell_surface.c). */
+int tcb_cell_surface_samples(const tcb_cell_job *job, void *self, int frame, tcb_surface_samples *s,
+                             tcb_error *merr, tcb_error *herr);
+
 /* The reconstruction metrics of the cell's evaluated frames (every frame of
  * the split's pairs and of the clips, once each, ascending) into
  * c->surface and c->summary.recon, when the method gives surfaces and
