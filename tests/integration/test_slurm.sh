@@ -11,6 +11,8 @@
 # queued, not missing, and submit.sh resubmits only the cancelled one; all
 # end with the uninterrupted cells. Needs root and Debian's slurm-wlm and
 # munge (scripts/setup.sh --tests installs them); skips loudly otherwise.
+# A per-clip grid (docs/protocol.md, "Per-clip fitting") over two array
+# tasks equals its local run too.
 # The daemons are stopped whatever happens.
 set -euo pipefail
 : "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
@@ -41,6 +43,23 @@ TCBENCH="$TCBENCH" "$TCB_SOURCE_DIR/scripts/slurm/submit.sh" grid.json --out "$t
     --sbatch "--wait -c 1 -o $tmp/task-%a.log" > submit.txt 2>&1 || { cat submit.txt task-*.log slurmctld.log; exit 1; }
 grep -qxF "submit.sh: using $(realpath "$TCBENCH") (TCBENCH)" submit.txt || { cat submit.txt; exit 1; }
 same_cells plain slurm
+
+# A per-clip grid (each clip fitted on its own: a cell per clip and method)
+# over two array tasks equals its local run.
+cat > clips.json <<'JSON'
+{ "name": "clips", "splits_dir": "splits", "cache_dir": "", "threads": 1,
+  "evaluation": { "protocol": "clips", "fit": "per_clip", "pool_size": 1000, "input_points": 300,
+                  "surface_samples": 500 },
+  "datasets": [ { "name": "synth", "source": "synthetic", "frames": 20, "normalization": "clip_bbox",
+                  "sequences": [ { "name": "quadruped_walk", "role": "test", "clip_starts": [0, 3] } ] } ],
+  "methods": [ { "name": "nearest" },
+               { "name": "mca", "params": { "preset": "tiny", "iterations": 60, "checkpoint_every": 0 } } ] }
+JSON
+"$TCBENCH" run clips.json --out clips-plain --quiet 2> /dev/null
+TCBENCH="$TCBENCH" "$TCB_SOURCE_DIR/scripts/slurm/submit.sh" clips.json --tasks 2 --out "$tmp/clips-slurm" \
+    --sbatch "--wait -c 1 -o $tmp/clips-%a.log" > submit.txt 2>&1 || { cat submit.txt clips-*.log; exit 1; }
+[ "$(find clips-slurm/cells -name 'seed_0.json' | wc -l)" -eq 4 ] || { echo "FAIL: per-clip cells"; exit 1; }
+same_cells clips-plain clips-slurm
 
 # Stops: three trainings (cells 1-3) after a nearest cell (0), one-CPU tasks.
 sed 's/"iterations": 100/"iterations": 800/; s/"seeds": \[0, 1\]/"seeds": [0, 1, 2]/
