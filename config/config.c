@@ -37,7 +37,7 @@ static const char *const dfaust_keys[] = {"name", "source", "root", "optional", 
 static const char *const sequence_keys[] = {"name", "role", "clip_starts", "clip_of", "start", NULL};
 static const char *const method_keys[] = {"name", "method", "params", "seeds", "datasets", "plugin_fnv1a64", NULL};
 
-const char *const tcb_config_source_names[] = {"synthetic", "objdir", "dfaust", NULL};
+const char *const tcb_config_source_names[] = {"synthetic", "objdir", "dfaust", "clipdir", NULL};
 const char *const tcb_config_norm_names[] = {"none", "first_frame", "per_frame", "clip_bbox", "first_frame_diag", NULL};
 const char *const tcb_config_fit_names[] = {"sequence", "per_clip", NULL};
 const char *const tcb_config_input_normals_names[] = {"none", "gt", "estimated", NULL};
@@ -272,7 +272,8 @@ static int parse_dataset(const cJSON *o, const char *where, int per_clip, tcb_da
     if (!rc) rc = copy_str(d->root, sizeof d->root, root, where, "root", err);
     if (!rc) rc = tcb_json_bool(o, "optional", where, 0, 0, &d->optional, err);
     if (!rc)
-        rc = tcb_json_enum(o, "normalization", where, 0, dfaust ? TCB_NORM_NONE : TCB_NORM_FIRST_FRAME,
+        rc = tcb_json_enum(o, "normalization", where, 0,
+                           dfaust || d->source == TCB_SOURCE_CLIPDIR ? TCB_NORM_NONE : TCB_NORM_FIRST_FRAME,
                            tcb_config_norm_names, &norm, err);
     long long align_samples;
     if (!rc) rc = tcb_json_bool(o, "align_rotation", where, 0, 0, &d->align_rotation, err);

@@ -134,6 +134,10 @@ int tcb_sequence_apply_yaw(tcb_sequence *s, const int *step, tcb_error *err)
         s->yaw[f] = tcb_align_step_radians(step[f]);
         float *v = s->verts + (size_t)f * s->n_verts * 3;
         rotate_y(v, v, s->n_verts, s->yaw[f]);
+        if (s->track) {
+            float *t = s->track + (size_t)f * s->n_track * 3;
+            rotate_y(t, t, s->n_track, s->yaw[f]);
+        }
     }
     return TCB_OK;
 }

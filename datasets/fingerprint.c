@@ -25,5 +25,6 @@ uint64_t tcb_sequence_fingerprint(const tcb_sequence *s)
         int32_t normals = (int32_t)s->input_normals;
         h = tcb_fnv1a64(h, &normals, sizeof normals);
     }
+    if (s->track) h = tcb_fnv1a64(h, s->track, (size_t)s->n_frames * (size_t)s->n_track * 3 * sizeof *s->track);
     return h;
 }

@@ -46,6 +46,7 @@ void tcb_sequence_free(tcb_sequence *s)
     free(s->norm_shift);
     free(s->yaw);
     free(s->blocks);
+    free(s->track);
     memset(s, 0, sizeof *s);
 }
 
@@ -146,6 +147,9 @@ int tcb_sequence_normalize(tcb_sequence *s, tcb_normalization mode, tcb_error *e
         memcpy(shift, c, sizeof c);
         for (size_t i = 0; i < 3 * (size_t)s->n_verts; i++)
             v[i] = (float)(((double)v[i] - shift[i % 3]) / scale);
+        float *t = s->track ? s->track + (size_t)f * s->n_track * 3 : NULL;
+        for (size_t i = 0; t && i < 3 * (size_t)s->n_track; i++)
+            t[i] = (float)(((double)t[i] - shift[i % 3]) / scale);
         s->areas[f] = tcb_mesh_area(v, s->faces, s->n_faces);
     }
     s->norm = mode;
@@ -174,6 +178,14 @@ int tcb_sequence_cut(const tcb_sequence *from, int start, int n_frames, const ch
     out->input_points = from->input_points;
     out->draw_with_replacement = from->draw_with_replacement;
     out->input_normals = from->input_normals;
+    if (!from->track) return TCB_OK;
+    size_t track = (size_t)from->n_track * 3;
+    if (!(out->track = malloc((size_t)n_frames * track * sizeof *out->track))) {
+        tcb_sequence_free(out);
+        return tcb_fail(err, TCB_ERR_NOMEM, "sequence %s: out of memory", name);
+    }
+    memcpy(out->track, from->track + (size_t)start * track, (size_t)n_frames * track * sizeof *out->track);
+    out->n_track = from->n_track;
     return TCB_OK;
 }
 

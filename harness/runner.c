@@ -110,7 +110,10 @@ static int load_source(const tcb_dataset_spec *d, const char *name, const tcb_lo
     char dir[TCB_PATH_MAX];
     int rc = tcb_path_join(dir, sizeof dir, err, "%s/%s", d->root, name);
     if (!rc && !tcb_is_dir(dir)) rc = tcb_fail(err, TCB_ERR_IO, "%s: no such directory", dir);
-    return rc ? rc : tcb_sequence_load_objdir(dir, name, lo, seq, err);
+    if (rc || d->source != TCB_SOURCE_CLIPDIR) return rc ? rc : tcb_sequence_load_objdir(dir, name, lo, seq, err);
+    /* 17 frames: no cache */
+    rc = tcb_sequence_read_clipdir(dir, name, seq, err);
+    return rc ? rc : tcb_sequence_prepare(seq, lo, err);
 }
 
 /* A clip of sequence s->clip_of fitted on its own: that sequence read

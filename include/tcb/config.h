@@ -62,7 +62,11 @@
  *         "sampling": "with_replacement",  this one's (reference-protocol §1.2, §1.3)
  *         "optional": false,               as objdir; no "align_rotation" (it would chain
  *                                          frames across subjects)
- *         "sequences": [ { "name": "jumping_jacks", "role": "validation" } ] } ],
+ *         "sequences": [ { "name": "jumping_jacks", "role": "validation" } ] },
+ *       { "name": "ama", "source": "clipdir",   the authors' clip folders (tcb/sequence.h,
+ *         "root": "data/AMA",               tcb_sequence_read_clipdir): <root>/<clip>/gt/NNNN.obj
+ *         "normalization": "none",          and pcl_seqs/NNNN.npy; their coordinates by default
+ *         "sequences": [ { "name": "crane_0010", "role": "test" } ] } ],
  *     "methods": [ { "name": "oracle" },
  *                  { "name": "mine", "method": "external",   a program of yours (docs/adding-a-method.md §6);
  *                    "params": { "command": ["mine.py", "--x"], a .py script runs under params "python", else
@@ -87,7 +91,7 @@
 extern "C" {
 #endif
 
-typedef enum tcb_source { TCB_SOURCE_SYNTHETIC, TCB_SOURCE_OBJDIR, TCB_SOURCE_DFAUST } tcb_source;
+typedef enum tcb_source { TCB_SOURCE_SYNTHETIC, TCB_SOURCE_OBJDIR, TCB_SOURCE_DFAUST, TCB_SOURCE_CLIPDIR } tcb_source;
 
 typedef struct tcb_sequence_spec {
     char name[TCB_NAME_MAX];

@@ -76,6 +76,12 @@ typedef struct tcb_sequence {
      * method that takes normals gets them with tcb_sequence_input_normals
      * (tcb/input_normals.h). */
     tcb_input_normals input_normals;
+    /* Tracked GT points besides the vertices (the authors' clip folders'
+     * pcl_seqs: point k is the same surface point in every frame), moved by
+     * the normalization and alignment as the vertices; DynoSurf's Corr
+     * matches against them. 0, NULL when the source has none. */
+    int n_track;
+    float *track;       /* [n_frames][n_track][3] */
 } tcb_sequence;
 
 static inline const float *tcb_seq_frame(const tcb_sequence *s, int f)
@@ -131,6 +137,17 @@ uint64_t tcb_sequence_fingerprint(const tcb_sequence *s);
  * blocks, pools or normalization yet (tcb_sequence_prepare). */
 int tcb_sequence_cut(const tcb_sequence *from, int start, int n_frames, const char *name, tcb_sequence *out,
                      tcb_error *err);
+
+/* A clip folder as DynoSurf, PDG and Neu-PiG distribute theirs: the GT
+ * meshes <dir>/gt/NNNN.obj (of one topology, ordered by number) and, when
+ * <dir>/pcl_seqs exists, one <dir>/pcl_seqs/NNNN.npy per mesh, each an
+ * (N, 3) float array of the same N (the tracked points). Raw, like
+ * tcb_sequence_read_objdir; errors name the file (datasets/clipdir.c). */
+int tcb_sequence_read_clipdir(const char *dir, const char *name, tcb_sequence *out, tcb_error *err);
+/* One pcl_seqs frame parsed from buf[0..len): an (n, 3) float array of
+ * finite values into *pts (malloc'ed [n][3]); n must be want when want > 0.
+ * Errors say what is wrong, without a file name (the fuzz target's entry). */
+int tcb_track_frame_parse(const void *buf, size_t len, int want, float **pts, int *n, tcb_error *err);
 
 /* Write every frame as <dir>/mesh_NNNN.obj (atomically, one file each). */
 int tcb_sequence_write_objdir(const tcb_sequence *s, const char *dir, tcb_error *err);

@@ -102,6 +102,16 @@ conf short.json '{"evaluation": {"pairs": 2, "protocol": "clips"}}'
 row "the clip protocol on a sequence shorter than 17 frames" run short.json
 conf surface.json '{"evaluation": {"pairs": 2, "surface_samples": 0}}'
 row "no surface samples for the reconstruction metrics" run surface.json
+conf perclip.json '{"evaluation": {"pairs": 2, "protocol": ["pairs", "clips"], "fit": "per_clip"}}'
+row "per-clip fitting with the pairs protocol" run perclip.json
+conf starts.json '{"datasets": [{"name": "synth", "source": "synthetic", "sequences": [{"name": "quadruped_walk", "role": "test", "clip_starts": [0]}]}]}'
+row "clip starts without per-clip fitting" run starts.json
+conf past.json '{"evaluation": {"protocol": "clips", "fit": "per_clip"}, "datasets": [{"name": "synth", "source": "synthetic", "frames": 20, "sequences": [{"name": "quadruped_walk", "role": "test", "clip_starts": [10]}]}]}'
+row "a clip past the sequence's end" run past.json
+conf whole.json '{"evaluation": {"protocol": "clips", "fit": "per_clip"}, "datasets": [{"name": "synth", "source": "synthetic", "frames": 20, "sequences": [{"name": "quadruped_walk", "role": "test"}]}]}'
+row "per-clip fitting of a sequence that is no clip" run whole.json
+conf frame.json '{"evaluation": {"pairs": 2, "recon_frame": "unit"}}'
+row "an unknown frame of the reconstruction metrics" run frame.json
 rm -rf runs splits
 
 # ---- OBJ frames
@@ -121,6 +131,29 @@ row "a single frame" run objs.json
 frames; rm objs/s/*.obj
 row "no OBJ file" run objs.json
 rm -rf objs runs splits
+
+section "Clip folders (a \`clipdir\` dataset: the authors' \`gt/\` and \`pcl_seqs/\`)"
+conf clipdir.json '{"evaluation": {"pairs": 2, "protocol": "clips"}, "datasets": [{"name": "files", "source": "clipdir", "root": "clipdirs", "sequences": [{"name": "c", "role": "test"}]}]}'
+clip() {
+    rm -rf clipdirs runs splits; mkdir -p clipdirs/c/gt clipdirs/c/pcl_seqs
+    for f in data/quadruped_walk/*.obj; do
+        n=$(basename "$f" .obj); n=${n#mesh_}; cp "$f" "clipdirs/c/gt/$n.obj"
+    done
+    /usr/bin/python3 -c 'import sys, numpy as np
+for k in range(4): np.save("clipdirs/c/pcl_seqs/%04d.npy" % k, np.full((50, 3), 0.01 * k, np.float32))'
+}
+clip; rm clipdirs/c/gt/0001.obj
+row "a missing frame" run clipdir.json
+clip; echo "v 0 0 0" >> clipdirs/c/gt/0002.obj
+row "a frame of another topology" run clipdir.json
+clip; truncate -s 100 clipdirs/c/pcl_seqs/0001.npy
+row "a truncated tracked-points frame" run clipdir.json
+clip; /usr/bin/python3 -c 'import numpy as np
+p = np.load("clipdirs/c/pcl_seqs/0002.npy"); p[3, 0] = np.nan; np.save("clipdirs/c/pcl_seqs/0002.npy", p)'
+row "a NaN tracked point" run clipdir.json
+clip; rm clipdirs/c/pcl_seqs/0003.npy
+row "a frame without its tracked points" run clipdir.json
+rm -rf clipdirs runs splits
 
 # ---- split
 section "Split files (\`<splits_dir>/<dataset>/<sequence>.json\`)"
