@@ -8,6 +8,7 @@
 #include "tcb/npy.h"
 
 #include <inttypes.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -151,9 +152,22 @@ static int64_t integer_element(const tcb_npy *a, uint64_t c, int *beyond_int64)
     return s;
 }
 
+/* IEEE 754 binary16 (numpy's float16: Occupancy Flow's point clouds),
+ * exactly: every half is a double. */
+static double half_value(uint32_t h)
+{
+    int sign = h >> 15, exp = (h >> 10) & 0x1f;
+    uint32_t mant = h & 0x3ff;
+    double v = exp == 0    ? ldexp((double)mant, -24)                        /* zero, subnormal */
+               : exp == 31 ? (mant ? NAN : INFINITY)
+                           : ldexp((double)(mant | 0x400), exp - 25);     /* 1.mant × 2^(exp-15) */
+    return sign ? -v : v;
+}
+
 static double float_element(const tcb_npy *a, uint64_t c)
 {
     uint64_t v = element_bits(a, c);
+    if (a->item_size == 2) return half_value((uint32_t)v);
     if (a->item_size == 8) {
         double d;
         memcpy(&d, &v, sizeof d);

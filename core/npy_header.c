@@ -136,9 +136,9 @@ static int set_dtype(const cursor *c, const char *d, tcb_npy *out, tcb_error *er
     if (d[0] == '=')
         return bad(c, err, "'descr': '%s': native byte order '=' does not say the writer's", d);
     if (strlen(d) != 3 || !strchr("<>|", d[0]) || !strchr("biuf", d[1]) || !strchr("1248", d[2]) ||
-        (d[1] == 'b' && d[2] != '1') || (d[1] == 'f' && d[2] < '4'))
+        (d[1] == 'b' && d[2] != '1') || (d[1] == 'f' && d[2] < '2'))
         return bad(c, err, "'descr': dtype '%s' is not supported (read: b1, i1 i2 i4 i8, u1 u2 u4 u8, "
-                           "f4 f8, each after '<', '>' or '|')", d);
+                           "f2 f4 f8, each after '<', '>' or '|')", d);
     if (d[0] == '|' && d[2] != '1')
         return bad(c, err, "'descr': '%s': byte order '|' (not applicable) on a multi-byte type", d);
     snprintf(out->descr, sizeof out->descr, "%s", d);

@@ -9,10 +9,11 @@
  * then the elements, nothing else.
  *
  * Read here: the dtypes numpy writes as "[<>|]" + kind + size for bool (b1),
- * signed and unsigned integers (i1 i2 i4 i8, u1 u2 u4 u8) and floats (f4 f8),
+ * signed and unsigned integers (i1 i2 i4 i8, u1 u2 u4 u8) and floats (f2 f4 f8;
+ * f2, IEEE half, converts exactly),
  * either byte order, C or Fortran order, any number of dimensions up to
  * TCB_NPY_MAX_DIMS. Refused with a message saying so: structured, object,
- * string, complex, half and datetime dtypes. The header is parsed strictly
+ * string, complex and datetime dtypes. The header is parsed strictly
  * (exactly the three keys; a one-element shape needs its comma, as in
  * Python), and the data must be exactly as long as the shape says.
  *

@@ -291,7 +291,7 @@ n = 1
 for s in shape: n *= s
 head = "{'descr': '%s', 'fortran_order': False, 'shape': %r, }" % (descr, tuple(shape))
 head += " " * (63 - (10 + len(head)) % 64) + "\n"
-fmt = {"<i4": "i", "<f4": "f", "<f2": "e"}[descr]
+fmt = {"<i4": "i", "<f4": "f", "<c8": "q"}[descr]  # c8: 8 bytes of zeros an element
 data = values if values is not None else [0] * n
 os.makedirs(d, exist_ok=True)
 with open(os.path.join(d, "%d.npy" % k), "wb") as f:
@@ -309,7 +309,7 @@ preds; echo "0 1 2" > pred/1.npy
 row "not .npy" score
 preds; cut_half pred/1.npy
 row "cut short" score
-preds; npy pred 1 '<f2' "($K,)"
+preds; npy pred 1 '<c8' "($K,)"
 row "an unsupported dtype" score
 preds; npy pred 1 '<f4' "($K, 2)"
 row "a wrong shape" score

@@ -214,6 +214,36 @@ static int parse_header(const char *header, size_t n_data, tcb_npy *a, tcb_error
     return tcb_npy_parse(buf, n, a, err);
 }
 
+/* float16 (Occupancy Flow's point clouds) converts exactly, either byte
+ * order: normal, subnormal, the largest, signed zero, infinity, NaN. */
+static void test_half_floats(void **state)
+{
+    (void)state;
+    static const uint16_t bits[] = {0x3c00, 0xc000, 0x0001, 0x03ff, 0x7bff, 0x3555, 0x8000, 0x7c00, 0xfc00, 0x7e00};
+    const double want[] = {1.0, -2.0, ldexp(1, -24), ldexp(1023, -24), 65504.0, 0x1.554p-2, -0.0, INFINITY, -INFINITY, NAN};
+    enum { N = sizeof bits / sizeof bits[0] };
+    for (int big = 0; big <= 1; big++) {
+        unsigned char data[2 * N], buf[512];
+        for (int k = 0; k < N; k++)
+            data[2 * k + big] = (unsigned char)(bits[k] & 0xff), data[2 * k + !big] = (unsigned char)(bits[k] >> 8);
+        char header[128];
+        snprintf(header, sizeof header, "{'descr': '%cf2', 'fortran_order': False, 'shape': (%d,)}", big ? '>' : '<', N);
+        size_t n = image(buf, 1, header, data, sizeof data);
+        tcb_npy a;
+        tcb_error err = {0};
+        assert_int_equal(tcb_npy_parse(buf, n, &a, &err), TCB_OK);
+        assert_int_equal(a.item_size, 2);
+        double got[N];
+        assert_int_equal(tcb_npy_to_double(&a, got, &err), TCB_OK);
+        for (int k = 0; k < N; k++) {
+            if (!same_double(got[k], want[k]) || signbit(got[k]) != signbit(want[k]))
+                fail_msg("%s half %04x: %a, expected %a", big ? "big-endian" : "little-endian", bits[k], got[k], want[k]);
+        }
+        int64_t ids[N];
+        assert_int_not_equal(tcb_npy_to_int64(&a, ids, &err), TCB_OK); /* floats are not ids */
+    }
+}
+
 static void test_bad_headers(void **state)
 {
     (void)state;
@@ -239,7 +269,7 @@ static void test_bad_headers(void **state)
         {"{'descr': '<u1', 'fortran_order': False, 'shape': (1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,"
          "1,1,1)}", 1, "more than 32 dimensions"},
         {"{'descr': '<c16', 'fortran_order': False, 'shape': ()}", 16, "dtype '<c16' is not supported"},
-        {"{'descr': '<f2', 'fortran_order': False, 'shape': ()}", 2, "dtype '<f2' is not supported"},
+        {"{'descr': '<f1', 'fortran_order': False, 'shape': ()}", 1, "dtype '<f1' is not supported"},
         {"{'descr': '|O', 'fortran_order': False, 'shape': ()}", 8, "dtype '|O' is not supported"},
         {"{'descr': '<b2', 'fortran_order': False, 'shape': ()}", 2, "dtype '<b2' is not supported"},
         {"{'descr': '|i4', 'fortran_order': False, 'shape': ()}", 4, "byte order '|' (not applicable) on a multi-byte"},
@@ -385,6 +415,7 @@ int main(void)
         cmocka_unit_test(test_signed_integers),
         cmocka_unit_test(test_unsigned_integers_and_bool),
         cmocka_unit_test(test_floats),
+        cmocka_unit_test(test_half_floats),
         cmocka_unit_test(test_points_orders_and_versions),
         cmocka_unit_test(test_scalar_and_empty),
         cmocka_unit_test(test_bad_headers),
