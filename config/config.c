@@ -32,12 +32,14 @@ static const char *const objdir_keys[] = {"name", "source", "root", "optional", 
                                           "align_rotation", "align_samples", "sampling", "sequences", NULL};
 /* No rotation alignment: it chains each frame to the previous one, which
  * across the subjects' blocks would be meaningless, and DFAUST has none. */
+static const char *const pcl_seq_keys[] = {"name", "source", "root", "optional", "normalization",
+                                           "sampling", "points", "sequences", NULL};
 static const char *const dfaust_keys[] = {"name", "source", "root", "optional", "normalization",
                                           "sampling", "subjects", "sequences", NULL};
 static const char *const sequence_keys[] = {"name", "role", "clip_starts", "clip_of", "start", NULL};
 static const char *const method_keys[] = {"name", "method", "params", "seeds", "datasets", "plugin_fnv1a64", NULL};
 
-const char *const tcb_config_source_names[] = {"synthetic", "objdir", "dfaust", "clipdir", NULL};
+const char *const tcb_config_source_names[] = {"synthetic", "objdir", "dfaust", "clipdir", "pcl_seq", NULL};
 const char *const tcb_config_norm_names[] = {"none", "first_frame", "per_frame", "clip_bbox", "first_frame_diag", NULL};
 const char *const tcb_config_fit_names[] = {"sequence", "per_clip", NULL};
 const char *const tcb_config_input_normals_names[] = {"none", "gt", "estimated", NULL};
@@ -263,7 +265,9 @@ static int parse_dataset(const cJSON *o, const char *where, int per_clip, tcb_da
     if (rc) return rc;
     d->source = (tcb_source)source;
     int synthetic = d->source == TCB_SOURCE_SYNTHETIC, dfaust = d->source == TCB_SOURCE_DFAUST;
-    rc = tcb_json_expect_keys(o, where, synthetic ? synthetic_keys : dfaust ? dfaust_keys : objdir_keys, err);
+    int pcl = d->source == TCB_SOURCE_PCL_SEQ;
+    rc = tcb_json_expect_keys(o, where,
+                              synthetic ? synthetic_keys : dfaust ? dfaust_keys : pcl ? pcl_seq_keys : objdir_keys, err);
     if (!rc) rc = tcb_json_str(o, "name", where, 1, NULL, &name, err);
     if (!rc) rc = check_name(name, sizeof d->name, where, "name", err);
     if (!rc) rc = tcb_json_int(o, "seed", where, 0, 0, 0, LLONG_MAX, &seed, err);
@@ -273,12 +277,14 @@ static int parse_dataset(const cJSON *o, const char *where, int per_clip, tcb_da
     if (!rc) rc = tcb_json_bool(o, "optional", where, 0, 0, &d->optional, err);
     if (!rc)
         rc = tcb_json_enum(o, "normalization", where, 0,
-                           dfaust || d->source == TCB_SOURCE_CLIPDIR ? TCB_NORM_NONE : TCB_NORM_FIRST_FRAME,
+                           dfaust || pcl || d->source == TCB_SOURCE_CLIPDIR ? TCB_NORM_NONE : TCB_NORM_FIRST_FRAME,
                            tcb_config_norm_names, &norm, err);
     long long align_samples;
     if (!rc) rc = tcb_json_bool(o, "align_rotation", where, 0, 0, &d->align_rotation, err);
     if (!rc) rc = tcb_json_int(o, "align_samples", where, 0, TCB_ALIGN_DEFAULT_SAMPLES, 1, 10000000, &align_samples, err);
     if (!rc) rc = tcb_json_enum(o, "sampling", where, 0, dfaust, tcb_config_sampling_names, &sampling, err);
+    long long points;
+    if (!rc) rc = tcb_json_int(o, "points", where, 0, TCB_PCL_SEQ_DEFAULT_POINTS, 0, 10000000, &points, err);
     if (!rc) rc = parse_subjects(o, where, d, err);
     if (rc) return rc;
     snprintf(d->name, sizeof d->name, "%s", name);
@@ -286,6 +292,7 @@ static int parse_dataset(const cJSON *o, const char *where, int per_clip, tcb_da
     d->frames = (int)frames;
     d->norm = (tcb_normalization)norm;
     d->with_replacement = sampling == 1;
+    d->points = pcl ? (int)points : 0;
     d->align_samples = d->align_rotation ? (int)align_samples : 0;
     return parse_sequences(o, where, per_clip, d, err);
 }

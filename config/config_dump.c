@@ -50,8 +50,10 @@ static cJSON *dump_dataset(const tcb_dataset_spec *d)
         for (int k = 0; k < d->n_subjects; k++)
             cJSON_AddItemToArray(subjects, cJSON_CreateString(d->subjects[k]));
     }
+    if (d->source == TCB_SOURCE_PCL_SEQ) cJSON_AddNumberToObject(o, "points", d->points);
     cJSON_AddStringToObject(o, "normalization", tcb_config_norm_names[d->norm]);
-    if (d->source != TCB_SOURCE_DFAUST) cJSON_AddBoolToObject(o, "align_rotation", d->align_rotation);
+    if (d->source != TCB_SOURCE_DFAUST && d->source != TCB_SOURCE_PCL_SEQ)
+        cJSON_AddBoolToObject(o, "align_rotation", d->align_rotation);
     if (d->align_rotation) cJSON_AddNumberToObject(o, "align_samples", d->align_samples);
     cJSON_AddStringToObject(o, "sampling", tcb_config_sampling_names[d->with_replacement != 0]);
     cJSON *seqs = cJSON_AddArrayToObject(o, "sequences");

@@ -16,7 +16,7 @@ int tcb_sequence_alloc(tcb_sequence *s, const char *name, int n_frames, int n_ve
     memset(s, 0, sizeof *s);
     s->norm_scale = 1.0;
     s->input_points = TCB_DEFAULT_INPUT_POINTS;
-    if (n_frames <= 0 || n_verts <= 0 || n_faces <= 0)
+    if (n_frames <= 0 || n_verts <= 0 || n_faces < 0)
         return tcb_fail(err, TCB_ERR_INPUT, "sequence %s: bad sizes (%d frames, %d vertices, %d faces)",
                         name, n_frames, n_verts, n_faces);
     size_t len = strlen(name);
@@ -28,8 +28,8 @@ int tcb_sequence_alloc(tcb_sequence *s, const char *name, int n_frames, int n_ve
     s->n_verts = n_verts;
     s->n_faces = n_faces;
     s->verts = malloc((size_t)n_frames * (size_t)n_verts * 3 * sizeof(float));
-    s->faces = malloc((size_t)n_faces * 3 * sizeof(int32_t));
-    if (!s->verts || !s->faces) {
+    s->faces = n_faces ? malloc((size_t)n_faces * 3 * sizeof(int32_t)) : NULL;
+    if (!s->verts || (n_faces && !s->faces)) {
         tcb_sequence_free(s);
         return tcb_fail(err, TCB_ERR_NOMEM, "sequence %s: cannot allocate %d frames of %d vertices",
                         name, n_frames, n_verts);
@@ -127,6 +127,15 @@ static int norm_transform(const tcb_sequence *s, tcb_normalization mode, double 
     return tcb_fail(err, TCB_ERR_INPUT, "sequence %s: unknown normalization %d", s->name, (int)mode);
 }
 
+/* The mean of n points: per_frame's centre of a sequence of points alone. */
+static void points_centroid(const float *v, int n, double c[3])
+{
+    c[0] = c[1] = c[2] = 0.0;
+    for (int i = 0; i < n; i++)
+        for (int d = 0; d < 3; d++) c[d] += v[3 * (size_t)i + d];
+    for (int d = 0; d < 3; d++) c[d] /= n;
+}
+
 int tcb_sequence_normalize(tcb_sequence *s, tcb_normalization mode, tcb_error *err)
 {
     if (s->pools)
@@ -143,7 +152,8 @@ int tcb_sequence_normalize(tcb_sequence *s, tcb_normalization mode, tcb_error *e
         double *shift = s->norm_shift + 3 * (size_t)f;
         /* PER_FRAME stands in for the authors' per-fetch centroid of the
          * 2500 drawn points: its expectation, so deterministic. */
-        if (mode == TCB_NORM_PER_FRAME) tcb_surface_centroid(v, s->faces, s->n_faces, c);
+        if (mode == TCB_NORM_PER_FRAME && s->n_faces) tcb_surface_centroid(v, s->faces, s->n_faces, c);
+        if (mode == TCB_NORM_PER_FRAME && !s->n_faces) points_centroid(v, s->n_verts, c);
         memcpy(shift, c, sizeof c);
         for (size_t i = 0; i < 3 * (size_t)s->n_verts; i++)
             v[i] = (float)(((double)v[i] - shift[i % 3]) / scale);
@@ -174,7 +184,7 @@ int tcb_sequence_cut(const tcb_sequence *from, int start, int n_frames, const ch
     if (rc) return rc;
     size_t frame = (size_t)from->n_verts * 3;
     memcpy(out->verts, from->verts + (size_t)start * frame, (size_t)n_frames * frame * sizeof *out->verts);
-    memcpy(out->faces, from->faces, (size_t)from->n_faces * 3 * sizeof *out->faces);
+    if (from->n_faces) memcpy(out->faces, from->faces, (size_t)from->n_faces * 3 * sizeof *out->faces);
     out->input_points = from->input_points;
     out->draw_with_replacement = from->draw_with_replacement;
     out->input_normals = from->input_normals;
@@ -186,6 +196,16 @@ int tcb_sequence_cut(const tcb_sequence *from, int start, int n_frames, const ch
     }
     memcpy(out->track, from->track + (size_t)start * track, (size_t)n_frames * track * sizeof *out->track);
     out->n_track = from->n_track;
+    return TCB_OK;
+}
+
+/* Without faces the vertices are the surface's samples (Occupancy Flow
+ * drew them by area): a pool is n of them, uniformly with replacement. */
+static int sample_points(const tcb_sequence *s, int f, int n, tcb_rng *rng, float *out)
+{
+    const float *v = tcb_seq_frame(s, f);
+    for (int i = 0; i < n; i++)
+        memcpy(out + 3 * (size_t)i, v + 3 * (size_t)tcb_rng_below(rng, (uint32_t)s->n_verts), 3 * sizeof(float));
     return TCB_OK;
 }
 
@@ -204,8 +224,9 @@ int tcb_sequence_sample_pools(tcb_sequence *s, int pool_size, uint64_t seed, tcb
         snprintf(label, sizeof label, "pool/%s/%d", s->name, f);
         tcb_rng rng;
         tcb_rng_seed_stream(&rng, seed, label);
-        int rc = tcb_sample_surface(tcb_seq_frame(s, f), s->faces, s->n_faces, pool_size, &rng,
-                                    pools + (size_t)f * pool_size * 3, err);
+        int rc = s->n_faces ? tcb_sample_surface(tcb_seq_frame(s, f), s->faces, s->n_faces, pool_size, &rng,
+                                                 pools + (size_t)f * pool_size * 3, err)
+                            : sample_points(s, f, pool_size, &rng, pools + (size_t)f * pool_size * 3);
         if (rc) {
             free(pools);
             tcb_error_prefix(err, "sequence %s frame %d: ", s->name, f);

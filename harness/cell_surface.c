@@ -121,7 +121,8 @@ static int stopped(const tcb_cell_job *job, int done, int total, tcb_error *herr
 void tcb_cell_surface_metrics(const tcb_cell_job *job, void *self, tcb_cell_result *c, tcb_error *merr,
                               tcb_error *herr)
 {
-    if (job->surface_samples <= 0 || !tcb_method_has_surface(job->ops)) return;
+    /* points alone (no GT surface): nothing to measure a surface against */
+    if (job->surface_samples <= 0 || !tcb_method_has_surface(job->ops) || !job->seq->n_faces) return;
     unsigned char *used = calloc((size_t)job->seq->n_frames, 1);
     tcb_surface_samples s = {0};
     if (!used || tcb_surface_samples_init(&s, job->surface_samples, job->seq->n_verts, herr)) {

@@ -51,6 +51,10 @@ static void probe_source(const tcb_dataset_spec *d, const char *name, int *n_fra
     if (tcb_run_root_missing(d)) return;
     int rc = d->source == TCB_SOURCE_DFAUST
                  ? tcb_dfaust_probe(d->root, name, d->subjects, d->n_subjects, n_frames, n_verts, &err)
+             : d->source == TCB_SOURCE_PCL_SEQ
+                 ? (tcb_path_join(dir, sizeof dir, &err, "%s/%s", d->root, name)
+                        ? TCB_ERR_INPUT
+                        : tcb_sequence_probe_pcl_seq(dir, d->points, n_frames, n_verts, &err))
              : tcb_path_join(dir, sizeof dir, &err, "%s/%s%s", d->root, name, d->source == TCB_SOURCE_CLIPDIR ? "/gt" : "")
                  ? TCB_ERR_INPUT
                  : tcb_sequence_probe_objdir(dir, n_frames, n_verts, &err);

@@ -110,9 +110,11 @@ static int load_source(const tcb_dataset_spec *d, const char *name, const tcb_lo
     char dir[TCB_PATH_MAX];
     int rc = tcb_path_join(dir, sizeof dir, err, "%s/%s", d->root, name);
     if (!rc && !tcb_is_dir(dir)) rc = tcb_fail(err, TCB_ERR_IO, "%s: no such directory", dir);
-    if (rc || d->source != TCB_SOURCE_CLIPDIR) return rc ? rc : tcb_sequence_load_objdir(dir, name, lo, seq, err);
-    /* 17 frames: no cache */
-    rc = tcb_sequence_read_clipdir(dir, name, seq, err);
+    if (rc) return rc;
+    /* the clip folders (17 frames) and point sequences: no cache */
+    if (d->source == TCB_SOURCE_CLIPDIR) rc = tcb_sequence_read_clipdir(dir, name, seq, err);
+    else if (d->source == TCB_SOURCE_PCL_SEQ) rc = tcb_sequence_read_pcl_seq(dir, name, d->points, seq, err);
+    else return tcb_sequence_load_objdir(dir, name, lo, seq, err);
     return rc ? rc : tcb_sequence_prepare(seq, lo, err);
 }
 

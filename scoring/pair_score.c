@@ -11,6 +11,7 @@ int tcb_pair_scorer_init(tcb_pair_scorer *s, const tcb_sequence *seq, tcb_error 
 {
     memset(s, 0, sizeof *s);
     s->seq = seq;
+    if (!seq->n_faces) return TCB_OK; /* points alone: no geodesic error */
     int rc = tcb_edge_graph_build(seq->faces, seq->n_faces, seq->n_verts, &s->graph, err);
     if (rc) tcb_error_prefix(err, "%s: ", seq->name);
     return rc;
@@ -38,7 +39,8 @@ int tcb_cell_score_pair(const tcb_pair_scorer *s, const tcb_pair_prediction *p, 
     int rc = p->moved ? tcb_project_to_vertices(verts_j, nv, p->moved, nv, p->pred, err) : TCB_OK;
     if (!rc) rc = tcb_pair_metrics_compute(verts_j, nv, p->pred, &m, err);
     /* after the paper's metrics, which reset m */
-    if (!rc) rc = tcb_pair_geodesic_compute(&s->graph, verts_j, seq->areas[p->j], p->pred, &m, p->geo, err);
+    if (!rc && seq->n_faces)
+        rc = tcb_pair_geodesic_compute(&s->graph, verts_j, seq->areas[p->j], p->pred, &m, p->geo, err);
     if (rc) return rc;
     *rec = tcb_pair_record_of(p->i, p->j, &m, p->cd);
     tcb_summary_add_pair(sum, &m, p->cd);

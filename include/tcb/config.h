@@ -66,7 +66,11 @@
  *       { "name": "ama", "source": "clipdir",   the authors' clip folders (tcb/sequence.h,
  *         "root": "data/AMA",               tcb_sequence_read_clipdir): <root>/<clip>/gt/NNNN.obj
  *         "normalization": "none",          and pcl_seqs/NNNN.npy; their coordinates by default
- *         "sequences": [ { "name": "crane_0010", "role": "test" } ] } ],
+ *         "sequences": [ { "name": "crane_0010", "role": "test" } ] },
+ *       { "name": "dfaust", "source": "pcl_seq",  Occupancy Flow's point clouds (no faces):
+ *         "root": "data/Humans/D-FAUST",     <root>/<sequence>/pcl_seq/NNNNNNNN.npz
+ *         "points": 10000,                  the points kept, the same in every frame (0: all)
+ *         "sequences": [ { "name": "50002_light_hopping_loose", "role": "test" } ] } ],
  *     "methods": [ { "name": "oracle" },
  *                  { "name": "mine", "method": "external",   a program of yours (docs/adding-a-method.md §6);
  *                    "params": { "command": ["mine.py", "--x"], a .py script runs under params "python", else
@@ -91,7 +95,13 @@
 extern "C" {
 #endif
 
-typedef enum tcb_source { TCB_SOURCE_SYNTHETIC, TCB_SOURCE_OBJDIR, TCB_SOURCE_DFAUST, TCB_SOURCE_CLIPDIR } tcb_source;
+typedef enum tcb_source {
+    TCB_SOURCE_SYNTHETIC,
+    TCB_SOURCE_OBJDIR,
+    TCB_SOURCE_DFAUST,
+    TCB_SOURCE_CLIPDIR,
+    TCB_SOURCE_PCL_SEQ
+} tcb_source;
 
 typedef struct tcb_sequence_spec {
     char name[TCB_NAME_MAX];
@@ -104,6 +114,11 @@ typedef struct tcb_sequence_spec {
     int start;
 } tcb_sequence_spec;
 
+/* pcl_seq: the points a frame keeps by default (the rank metric compares
+ * every vertex with every other: Occupancy Flow's 100 000 would be 10^10
+ * distances a pair). */
+#define TCB_PCL_SEQ_DEFAULT_POINTS 10000
+
 typedef struct tcb_dataset_spec {
     char name[64];
     tcb_source source;
@@ -115,6 +130,7 @@ typedef struct tcb_dataset_spec {
     int align_samples;       /* its vertex subset; 0 without align_rotation */
     int with_replacement;
     int optional;
+    int points;              /* pcl_seq: the points kept a frame (0: all) */
     int n_subjects;          /* dfaust: the listed subjects; 0 = every one found */
     char **subjects;
     int n_sequences;

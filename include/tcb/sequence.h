@@ -7,6 +7,11 @@
  * (reference-protocol §1.3) and carries per frame a pool of area-uniform
  * surface samples from which methods draw their input clouds (§1.2).
  *
+ * A sequence of points alone (Occupancy Flow's pcl_seq) has no faces
+ * (n_faces 0, faces NULL): its pools are drawn from its vertices, and what
+ * needs a surface (the geodesic error, the reconstruction metrics, GT
+ * normals) is not computed for it.
+ *
  * Ownership: a tcb_sequence owns all its arrays; tcb_sequence_free releases
  * them. Methods receive `const tcb_sequence *` and must not keep pointers
  * into it beyond `destroy`. */
@@ -148,6 +153,19 @@ int tcb_sequence_read_clipdir(const char *dir, const char *name, tcb_sequence *o
  * finite values into *pts (malloc'ed [n][3]); n must be want when want > 0.
  * Errors say what is wrong, without a file name (the fuzz target's entry). */
 int tcb_track_frame_parse(const void *buf, size_t len, int want, float **pts, int *n, tcb_error *err);
+
+/* Occupancy Flow's point-cloud sequence <dir>/pcl_seq/NNNNNNNN.npz
+ * (points float16, loc, scale; frames numbered without gaps) in world
+ * coordinates (loc + scale·points): a sequence without faces (n_faces 0)
+ * of `keep` of its points (0: all), the same in every frame, chosen by the
+ * stream "pcl_seq/<name>" (datasets/pcl_seq.c). */
+int tcb_sequence_read_pcl_seq(const char *dir, const char *name, int keep, tcb_sequence *out, tcb_error *err);
+/* Its frame count and the vertices a sequence keeps, reading one frame:
+ * what a dry run needs. */
+int tcb_sequence_probe_pcl_seq(const char *dir, int keep, int *n_frames, int *n_verts, tcb_error *err);
+/* One such frame: its N points in world coordinates into *world
+ * (malloc'ed [N][3]); N must be want when want > 0. Errors name the file. */
+int tcb_pcl_seq_frame_read(const char *path, int want, float **world, int *n, tcb_error *err);
 
 /* Write every frame as <dir>/mesh_NNNN.obj (atomically, one file each). */
 int tcb_sequence_write_objdir(const tcb_sequence *s, const char *dir, tcb_error *err);

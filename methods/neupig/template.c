@@ -31,6 +31,9 @@ static void unit_face_normal(const float *a, const float *b, const float *c, flo
 static int gt_normals(const tcb_sequence *seq, int key, const tcb_neupig_frame_map *map, const float *cloud,
                       int n, float *normals, tcb_error *err)
 {
+    if (!seq->n_faces)
+        return tcb_fail(err, TCB_ERR_INPUT, "GT normals need the GT surface, and sequence %s is points alone "
+                        "(\"normals\": \"estimated\", or \"input_normals\": \"estimated\")", seq->name);
     float *gt = malloc((size_t)seq->n_verts * 3 * sizeof *gt);
     tcb_surface_point *loc = malloc((size_t)n * sizeof *loc);
     int rc = gt && loc ? TCB_OK : tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");

@@ -6,6 +6,7 @@
 
 #include "methods/nricp/nricp_internal.h"
 #include "tcb/geometry.h"
+#include "tcb/meshing.h"
 
 int nricp_prepare(nricp_method *m, const tcb_sequence *seq, tcb_error *err)
 {
@@ -21,8 +22,13 @@ int nricp_prepare(nricp_method *m, const tcb_sequence *seq, tcb_error *err)
     free(m->normals);
     m->normals = malloc((size_t)seq->n_frames * frame * sizeof *m->normals);
     if (!m->normals) return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory for normals");
-    for (int f = 0; f < seq->n_frames; f++)
-        tcb_vertex_normals(tcb_seq_frame(seq, f), seq->n_verts, seq->faces, seq->n_faces,
-                           m->normals + f * frame);
-    return TCB_OK;
+    /* A sequence of points alone: normals estimated from the points (PCA,
+     * oriented), where a mesh's come from its faces. */
+    int rc = TCB_OK;
+    for (int f = 0; f < seq->n_frames && !rc; f++)
+        if (seq->n_faces)
+            tcb_vertex_normals(tcb_seq_frame(seq, f), seq->n_verts, seq->faces, seq->n_faces, m->normals + f * frame);
+        else
+            rc = tcb_estimate_normals(tcb_seq_frame(seq, f), seq->n_verts, TCB_NORMALS_K, m->normals + f * frame, err);
+    return rc;
 }

@@ -155,6 +155,25 @@ clip; rm clipdirs/c/pcl_seqs/0003.npy
 row "a frame without its tracked points" run clipdir.json
 rm -rf clipdirs runs splits
 
+section "Point-cloud sequences (a \`pcl_seq\` dataset: Occupancy Flow's \`pcl_seq/NNNNNNNN.npz\`)"
+conf pcl.json '{"datasets": [{"name": "files", "source": "pcl_seq", "root": "pcls", "sequences": [{"name": "p", "role": "test"}]}]}'
+pcl() {
+    rm -rf pcls runs splits; mkdir -p pcls/p/pcl_seq
+    /usr/bin/python3 -c 'import numpy as np
+for k in range(4): np.savez("pcls/p/pcl_seq/%08d.npz" % (80 + k), points=np.full((50, 3), 0.01 * k, np.float16), loc=np.zeros(3, np.float16), scale=np.float64(1.8))'
+}
+pcl; rm pcls/p/pcl_seq/00000081.npz
+row "a missing frame" run pcl.json
+pcl; truncate -s 200 pcls/p/pcl_seq/00000082.npz
+row "a truncated frame" run pcl.json
+pcl; /usr/bin/python3 -c 'import numpy as np
+z = dict(np.load("pcls/p/pcl_seq/00000083.npz")); z["points"][5, 1] = np.nan; np.savez("pcls/p/pcl_seq/00000083.npz", **z)'
+row "a NaN point" run pcl.json
+pcl; /usr/bin/python3 -c 'import numpy as np
+z = dict(np.load("pcls/p/pcl_seq/00000081.npz")); z["points"] = z["points"][:40]; np.savez("pcls/p/pcl_seq/00000081.npz", **z)'
+row "another point count" run pcl.json
+rm -rf pcls runs splits
+
 # ---- split
 section "Split files (\`<splits_dir>/<dataset>/<sequence>.json\`)"
 conf split.json '{}'
