@@ -1,5 +1,6 @@
 #include "fuzz/fuzz_util.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -87,4 +88,16 @@ void fuzz_check_answer(int rc, const tcb_error *err, const char *path)
         fprintf(stderr, "message without the file's name %s: %s\n", path, err->msg);
         abort();
     }
+}
+
+void fuzz_check_point_frame(int rc, const tcb_error *err, const char *path, float *pts, int n, int want)
+{
+    fuzz_check_answer(rc, err, path);
+    if (rc) {
+        fuzz_require(!pts && n == 0, "a refused frame leaves nothing");
+        return;
+    }
+    fuzz_require(n >= 1 && (want == 0 || n == want), "the count asked for");
+    for (size_t i = 0; i < 3 * (size_t)n; i++) fuzz_require(isfinite(pts[i]), "finite points");
+    free(pts);
 }

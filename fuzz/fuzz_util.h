@@ -46,4 +46,9 @@ void fuzz_check_answer(int rc, const tcb_error *err, const char *path);
  * successful read must satisfy (indices in range, finite values). */
 void fuzz_require(int cond, const char *what);
 
+/* The answer of a reader of one frame of points (n of them, asked for
+ * `want` when want > 0) checked: a refusal leaves nothing, an acceptance
+ * is finite points, as many as asked for; frees pts. */
+void fuzz_check_point_frame(int rc, const tcb_error *err, const char *path, float *pts, int n, int want);
+
 #endif

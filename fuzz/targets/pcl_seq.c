@@ -1,9 +1,6 @@
 /* One frame of Occupancy Flow's point-cloud sequences (datasets/pcl_seq.c):
  * an .npz whose points, loc and scale give world coordinates; what is
  * accepted is finite points, as many as asked for when a count is. */
-#include <math.h>
-#include <stdlib.h>
-
 #include "fuzz/fuzz_util.h"
 #include "tcb/sequence.h"
 
@@ -15,14 +12,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         int n = 0;
         tcb_error err = {0};
         int rc = tcb_pcl_seq_frame_read(path, want, &pts, &n, &err);
-        fuzz_check_answer(rc, &err, path);
-        if (rc) {
-            fuzz_require(!pts && n == 0, "a refused frame leaves nothing");
-            continue;
-        }
-        fuzz_require(n >= 1 && (want == 0 || n == want), "the count asked for");
-        for (size_t i = 0; i < 3 * (size_t)n; i++) fuzz_require(isfinite(pts[i]), "finite points");
-        free(pts);
+        fuzz_check_point_frame(rc, &err, path, pts, n, want);
     }
     return 0;
 }

@@ -1,9 +1,6 @@
 /* A clip folder's tracked points (datasets/clipdir.c, one pcl_seqs/NNNN.npy
  * frame), straight from the buffer: an accepted frame is (N, 3) finite
  * points, N the count asked for when one is; a refusal is one message. */
-#include <math.h>
-#include <stdlib.h>
-
 #include "fuzz/fuzz_util.h"
 #include "tcb/sequence.h"
 
@@ -14,14 +11,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         int n = 0;
         tcb_error err = {0};
         int rc = tcb_track_frame_parse(data, size, want, &pts, &n, &err);
-        fuzz_check_answer(rc, &err, NULL);
-        if (rc) {
-            fuzz_require(!pts && n == 0, "a refused frame leaves nothing");
-            continue;
-        }
-        fuzz_require(n >= 1 && (want == 0 || n == want), "the count asked for");
-        for (size_t i = 0; i < 3 * (size_t)n; i++) fuzz_require(isfinite(pts[i]), "finite points");
-        free(pts);
+        fuzz_check_point_frame(rc, &err, NULL, pts, n, want);
     }
     return 0;
 }

@@ -33,13 +33,7 @@ typedef struct dump {
 /* Appends bytes to OUT/name (a frame after the other). */
 static int append(const char *dir, const char *name, const void *data, size_t bytes, tcb_error *err)
 {
-    char path[TCB_PATH_MAX];
-    int rc = tcb_path_join(path, sizeof path, err, "%s/%s", dir, name);
-    if (rc) return rc;
-    FILE *f = fopen(path, "ab");
-    if (!f || fwrite(data, 1, bytes, f) != bytes || fclose(f))
-        return tcb_fail(err, TCB_ERR_IO, "%s: cannot write", path);
-    return TCB_OK;
+    return tcb_test_put_bin(dir, name, data, bytes, "ab", err);
 }
 
 static int write_meta(const dump *d, const tcb_uv_mesh *m, int n, tcb_error *err)
