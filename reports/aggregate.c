@@ -121,6 +121,7 @@ static int build_row(const tcb_cell_result *cells, int n, tcb_rpt_row *r, tcb_er
     memset(r, 0, sizeof *r);
     snprintf(r->method, sizeof r->method, "%s", cells[0].method);
     snprintf(r->method_impl, sizeof r->method_impl, "%s", cells[0].method_impl);
+    snprintf(r->normals, sizeof r->normals, "%s", cells[0].normals);
     const char *params = cells[0].params_json ? cells[0].params_json : "";
     if (strlen(params) < sizeof r->params) memcpy(r->params, params, strlen(params) + 1);
     r->n_seeds = n;
@@ -341,6 +342,7 @@ static void mean_row(const tcb_rpt_block *const *tests, int nt, const char *meth
         if (s->n_seeds > r->n_seeds) r->n_seeds = s->n_seeds;
         if (t == 0) memcpy(r->method_impl, s->method_impl, sizeof r->method_impl);
         if (t == 0) memcpy(r->params, s->params, sizeof r->params);
+        if (t == 0) memcpy(r->normals, s->normals, sizeof r->normals);
         r->n_pairs += s->n_pairs;
         for (int m = 0; m < TCB_N_METRICS; m++) {
             r->has[m] &= s->has[m];

@@ -71,6 +71,8 @@ typedef struct tcb_rpt_row {
     char method[64];
     char method_impl[64];             /* the registered method of its first cell */
     char params[256];                 /* that cell's params, compact JSON ("" when longer) */
+    char normals[16];                 /* the normals its first cell's method took ("gt",
+                                       * "estimated"; "" points only: tcb_cell_result.normals) */
     const char *status;               /* "ok", "failed", "diverged" or "missing" */
     char status_text[64];             /* status plus how many pooled parts had it */
     char message[TCB_ERRMSG_MAX];     /* first failing cell: "seed 1: …" */

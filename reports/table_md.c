@@ -45,6 +45,20 @@ static void write_unreachable_note(FILE *f, const tcb_rpt_block *b)
     }
 }
 
+/* Which methods took normals with their input points (the config's
+ * "input_normals", or their own estimate), and that the others took
+ * points only: a comparison of the two kinds should say so. */
+static void write_normals_note(FILE *f, const tcb_rpt_block *b)
+{
+    int with = 0;
+    for (int k = 0; k < b->n_rows; k++) with += b->rows[k].normals[0] != '\0';
+    if (!with) return;
+    fprintf(f, "\nNormals with the input points: ");
+    for (int k = 0, i = 0; k < b->n_rows; k++)
+        if (b->rows[k].normals[0]) fprintf(f, "%s%s (%s)", i++ ? ", " : "", b->rows[k].method, b->rows[k].normals);
+    fprintf(f, with < b->n_rows ? "; the other methods took points only.\n" : ".\n");
+}
+
 /* atlasnet and mca rows with the same params whose m_sL2 agree within 1 %:
  * a reader takes that for a bug (one method run twice) unless told why.
  * The two start from the same weights and draw the same batches (the
@@ -129,6 +143,7 @@ static void write_table(FILE *f, const tcb_rpt_block *b, const unsigned char *sh
         fprintf(f, "- %s: %s — %s\n", r->method, r->status_text, r->message);
     }
     write_marks_legend(f, b);
+    write_normals_note(f, b);
     write_unreachable_note(f, b);
     write_twin_note(f, b);
     fprintf(f, "\n");

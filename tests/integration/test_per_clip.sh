@@ -3,7 +3,8 @@
 # "Per-clip fitting"), on an OBJ sequence this test writes (a deforming
 # blob away from the origin, so every normalization moves it):
 # 1. each clip is a sequence and a cell (crane_0003-style names), the dry
-#    run prices every clip's fit (no "?"), the record keeps each clip;
+#    run prices every clip's fit (no "?"), the record keeps each clip, the
+#    report says which method took the input normals;
 # 2. the clip-frame metrics equal numpy following DynoSurf's evaluation/
 #    on the same meshes and points: the clip's normalization (clip_bbox,
 #    first_frame_diag) recomputed from the raw OBJ files, the frame box
@@ -88,7 +89,8 @@ for clip in ("blob_0003", "blob_0011"):
 print("per-clip grid: 2 clips x 3 methods, each a 17-frame sequence")
 PY
 "$TCBENCH" report box --quiet
-grep -q '^### toy / MEAN' box/report/tables.md && grep -q 'Corr-mesh ↓' box/report/tables.md ||
+grep -q '^### toy / MEAN' box/report/tables.md && grep -q 'Corr-mesh ↓' box/report/tables.md &&
+    grep -qxF 'Normals with the input points: neupig (gt); the other methods took points only.' box/report/tables.md ||
     { echo "FAIL: report"; cat box/report/tables.md; exit 1; }
 
 # 2. Against numpy, following DynoSurf's evaluation/ (utils.py:
