@@ -110,6 +110,22 @@ static void draw_mesh(cairo_t *cr, const camera *c, const tcb_render_panel *p,
     }
 }
 
+/* A sequence of points alone (no faces): each vertex a dot in its colour,
+ * far ones first. */
+static void draw_points(cairo_t *cr, const camera *c, const tcb_render_panel *p, int nv, face_depth *order)
+{
+    for (int v = 0; v < nv; v++) order[v] = (face_depth){p->verts[3 * (size_t)v + c->view], v};
+    qsort(order, (size_t)nv, sizeof *order, by_depth);
+    for (int o = 0; o < nv; o++) {
+        const uint8_t *rgb = p->rgb + 3 * (size_t)order[o].face;
+        double x, y;
+        project(c, p->verts + 3 * (size_t)order[o].face, &x, &y);
+        cairo_set_source_rgb(cr, rgb[0] / 255.0, rgb[1] / 255.0, rgb[2] / 255.0);
+        cairo_arc(cr, x, y, 1.4, 0, 2 * M_PI);
+        cairo_fill(cr);
+    }
+}
+
 static void draw_colorbar(cairo_t *cr, double max)
 {
     const double x0 = 40, x1 = PANEL - 40, y = PANEL + 8, h = 12;
@@ -136,7 +152,8 @@ int tcb_render_panels(const char *path, const tcb_render_panel *panels, int n_pa
                       const int32_t *faces, int nf, const float *ref, int n_ref, double colorbar_max,
                       tcb_error *err)
 {
-    face_depth *order = malloc((size_t)(nf > 0 ? nf : 1) * sizeof *order);
+    size_t n_order = (size_t)(nf > 0 ? nf : nv > 0 ? nv : 1);
+    face_depth *order = malloc(n_order * sizeof *order);
     if (!order) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory for %d faces", nf);
     camera c = make_camera(panels, n_panels, nv, ref, n_ref);
     cairo_surface_t *surface =
@@ -153,7 +170,8 @@ int tcb_render_panels(const char *path, const tcb_render_panel *panels, int n_pa
         cairo_move_to(cr, 12, 22);
         cairo_show_text(cr, panels[p].title);
         cairo_translate(cr, 0, TITLE);
-        draw_mesh(cr, &c, &panels[p], faces, nf, order);
+        if (nf > 0) draw_mesh(cr, &c, &panels[p], faces, nf, order);
+        else draw_points(cr, &c, &panels[p], nv, order);
         if (colorbar_max > 0 && p == n_panels - 1) draw_colorbar(cr, colorbar_max);
         cairo_restore(cr);
     }

@@ -17,7 +17,8 @@ typedef struct tcb_render_panel {
                               * vertex colours would blur across checks) */
 } tcb_render_panel;
 
-/* Panels of meshes sharing `faces` [nf][3] and vertex count nv, drawn side
+/* Panels of meshes sharing `faces` [nf][3] and vertex count nv (nf 0: points
+ * alone, each vertex a dot in its colour), drawn side
  * by side with one orthographic camera: looking along the axis in which
  * `ref` [n_ref][3] is thinnest (the side of an animal), y up where y is not
  * that axis, faces back to front, shaded by their slant to the viewer.

@@ -5,7 +5,8 @@
 # box, loc, scale) read back in world coordinates — nearest's Corr equals
 # numpy's from the files — with the metrics that need faces left out
 # (no m_geo, no CD-L2 rows) and nricp, neupig and mca running on points
-# alone; bad folders (a missing frame, a truncated npz, NaN points,
+# alone, inspect and frames drawing the points; bad folders (a missing
+# frame, a truncated npz, NaN points,
 # another point count, a missing array) are one error naming the file,
 # exit 2. With ../shared/data, the real D-FAUST clip the same way.
 set -euo pipefail
@@ -67,6 +68,11 @@ head = [l for l in open("run/report/tables.md") if l.startswith("| method |")][0
 assert "m_geo" not in head and "CD-L2" not in head and "Corr ↓" in head, head
 print("pcl_seq: world coordinates as numpy reads them; no metric that needs faces")
 PY
+
+# Pictures of points alone: dots instead of faces.
+"$TCBENCH" inspect run nricp 0 --out insp --quiet > /dev/null
+"$TCBENCH" frames run nearest --frames 0,5 --out strip --quiet > /dev/null
+[ -s insp/pair.png ] && [ -s strip/strip.png ] || { echo "FAIL: no pictures"; exit 1; }
 
 # Bad folders: one error naming the file, exit 2.
 one() { sed 's/"root": "pts"/"root": "bad"/' pts.json > bad.json; rm -rf bad && cp -r pts bad; }
