@@ -71,3 +71,20 @@ kill_when() {
     kill -9 "$pid" 2>/dev/null || true
     wait "$pid" 2>/dev/null || true
 }
+
+# kill_mid_fit CONFIG WORK CELL [RUN OPTIONS]: a run of CONFIG into killed/
+# is killed once the training state killed/WORK/train.ckpt exists and before
+# killed/CELL is written, then resumed, which its log must announce.
+kill_mid_fit() {
+    local config=$1 work=killed/$2 cell=killed/$3
+    shift 3
+    "$TCBENCH" run "$config" --out killed --quiet "$@" &
+    pid=$!
+    kill_when "$pid" test -s "$work/train.ckpt"
+    pid=""
+    [ -s "$work/train.ckpt" ] && [ ! -e "$cell" ] ||
+        { echo "FAIL: the kill did not land between the first checkpoint and the end"; exit 1; }
+    # Not quiet (CI=true would be): the resume is announced at log level info.
+    CI= "$TCBENCH" run "$config" --out killed "$@" 2> resume.log
+    grep -q "resuming training at iteration [1-9]" resume.log || { echo "FAIL: did not resume"; cat resume.log; exit 1; }
+}

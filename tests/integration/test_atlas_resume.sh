@@ -21,16 +21,7 @@ work=work/synth/quadruped_walk/mca/seed_0
 "$TCBENCH" run train.json --out full --quiet
 [ ! -e "full/$work/train.ckpt" ] || { echo "FAIL: training state left after a finished fit"; exit 1; }
 
-"$TCBENCH" run train.json --out killed --quiet &
-pid=$!
-kill_when "$pid" test -s "killed/$work/train.ckpt"
-pid=""
-[ -s "killed/$work/train.ckpt" ] && [ ! -e killed/cells/synth/quadruped_walk/mca/seed_0.json ] ||
-    { echo "FAIL: the kill did not land between the first checkpoint and the end"; exit 1; }
-
-# Not quiet (CI=true would be): the resume is announced at log level info.
-CI= "$TCBENCH" run train.json --out killed 2> resume.log
-grep -q "resuming training at iteration [1-9]" resume.log || { echo "FAIL: did not resume"; cat resume.log; exit 1; }
+kill_mid_fit train.json "$work" cells/synth/quadruped_walk/mca/seed_0.json
 same_cells full killed
 leftovers=$(find killed -name '*.tmp-*' -o -name train.ckpt)
 [ -z "$leftovers" ] || { echo "FAIL: left behind: $leftovers"; exit 1; }

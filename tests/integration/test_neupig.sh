@@ -71,13 +71,7 @@ PY
 "$TCBENCH" inspect full neupig 0 --out insp > inspect.txt
 grep -q "agree: largest relative difference 0.0e+00" inspect.txt || { cat inspect.txt; exit 1; }
 
-"$TCBENCH" run np.json --out killed --only neupig --quiet &
-pid=$!
-kill_when "$pid" test -s "killed/$work/train.ckpt"
-pid=""
-[ ! -e "killed/$cell" ] || { echo "FAIL: the kill did not land before the end of the training"; exit 1; }
-CI= "$TCBENCH" run np.json --out killed --only neupig 2> resume.log
-grep -q "resuming training at iteration [1-9]" resume.log || { echo "FAIL: did not resume"; cat resume.log; exit 1; }
+kill_mid_fit np.json "$work" "$cell" --only neupig
 "$TCBENCH" run np.json --out killed --only neupig_gt --quiet
 same_cells full killed
 

@@ -201,15 +201,7 @@ PY
 config long clip_bbox frame_box '[3]' \
     '[ { "name": "neupig", "params": { "preset": "tiny", "epochs": 80, "checkpoint_every": 2 } } ]'
 "$TCBENCH" run long.json --out whole --quiet
-"$TCBENCH" run long.json --out killed --quiet &
-pid=$!
-work=killed/work/toy/blob_0003/neupig/seed_0
-kill_when "$pid" test -s "$work/train.ckpt"
-pid=""
-[ -s "$work/train.ckpt" ] && [ ! -e killed/cells/toy/blob_0003/neupig/seed_0.json ] ||
-    { echo "FAIL: the kill did not land mid-fit"; exit 1; }
-CI= "$TCBENCH" run long.json --out killed 2> resume.log
-grep -q "resuming training at iteration [1-9]" resume.log || { echo "FAIL: did not resume"; cat resume.log; exit 1; }
+kill_mid_fit long.json work/toy/blob_0003/neupig/seed_0 cells/toy/blob_0003/neupig/seed_0.json
 same_cells whole killed
 
 # 4. Refusals: one line naming the key or the clip, exit 2.
