@@ -496,10 +496,20 @@ void tcb_rpt_cell_text(const tcb_rpt_row *r, int metric, const char *pm, char *o
                  r->std[metric]);
 }
 
-int tcb_rpt_dataset_shows(const tcb_rpt *r, const tcb_rpt_dataset *d, int m)
+static int dataset_has(const tcb_rpt *r, const tcb_rpt_dataset *d, int m)
 {
     for (int k = d->first; k < d->first + d->n; k++)
         for (int i = 0; i < r->blocks[k].n_rows; i++)
             if (r->blocks[k].rows[i].has[m]) return 1;
     return 0;
+}
+
+int tcb_rpt_dataset_shows(const tcb_rpt *r, const tcb_rpt_dataset *d, int m)
+{
+    if (dataset_has(r, d, m)) return 1;
+    /* no row with any number (every cell failed): the paper's columns, for
+     * the rows' statuses to stand in */
+    for (int o = 0; o < TCB_N_METRICS; o++)
+        if (dataset_has(r, d, o)) return 0;
+    return tcb_rpt_metrics[m].paper;
 }

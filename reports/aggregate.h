@@ -167,7 +167,8 @@ const tcb_rpt_cmp *tcb_rpt_cmp_of(const tcb_rpt_block *b, int ra, int rb, int *f
 int tcb_rpt_beats(const tcb_rpt_block *b, int r, int o, int m);
 void tcb_rpt_free(tcb_rpt *r);
 /* Whether a table of dataset d shows metric m: some row of its blocks has
- * it (a pairs-only run has no Corr column, a clips-only run no m_sL2). */
+ * it (a pairs-only run has no Corr column, a clips-only run no m_sL2); when
+ * no row has any number (every cell failed), the paper's four columns. */
 int tcb_rpt_dataset_shows(const tcb_rpt *r, const tcb_rpt_dataset *d, int m);
 
 /* One table cell: "mean<pm>std" in the metric's precision, "-" when the row

@@ -55,8 +55,8 @@ static void test_info(void **state)
 
 /* The row equals the record a cell gets for the same prediction, bit for
  * bit (the frames and the Chamfer distance left NaN, and the geodesic
- * error, which needs faces the binding is not given); sq, rank and pck are
- * the values behind it. */
+ * error, which needs faces: neither the binding nor a cell of points
+ * without faces has one); sq, rank and pck are the values behind it. */
 static void test_pair_metrics_is_the_cells_row(void **state)
 {
     (void)state;
@@ -72,8 +72,8 @@ static void test_pair_metrics_is_the_cells_row(void **state)
     assert_int_equal(tcb_binding_pair_metrics(v, K, pred, sq, rank, pck, TCB_PCK_STEPS, row, TCB_N_PAIR_COLUMNS,
                                               &err), TCB_OK);
 
-    /* a frame of points without faces: the cell's geodesic error falls back
-     * to the straight line everywhere (area 1), the binding has none */
+    /* a frame of points without faces: no geodesic error, in the cell as in
+     * the binding (not the straight line passed off as a path) */
     double area = 1.0;
     tcb_sequence one = {.n_frames = 1, .n_verts = K, .verts = v, .areas = &area};
     tcb_pair_prediction p = {4, 0, NULL, pred, NAN, NULL};
@@ -90,7 +90,8 @@ static void test_pair_metrics_is_the_cells_row(void **state)
     enum { CD = TCB_N_PAIR_COLUMNS_EUCLIDEAN - 1 };
     assert_true(isnan(row[0]) && isnan(row[1]) && isnan(row[CD]) && isnan(want[CD]));
     assert_memory_equal(row + 2, want + 2, (CD - 2) * sizeof *row);
-    for (int c = CD + 1; c < TCB_N_PAIR_COLUMNS; c++) assert_true(isnan(row[c]) && !isnan(want[c]));
+    for (int c = CD + 1; c < TCB_N_PAIR_COLUMNS; c++) assert_true(isnan(row[c]) && isnan(want[c]));
+    assert_true(sum.geo.n == 0 && sum.geo_auc.n == 0);
     assert_memory_equal(pck, m.pck, sizeof pck);
 
     double sq_want[K], rank_want[K];
