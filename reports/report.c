@@ -44,8 +44,9 @@ static int write_all(const tcb_rpt *r, const char *dir, tcb_error *err)
         (rc = write_text(dir, "comparisons.tex", tcb_rpt_write_cmp_tex, r, err)) ||
         (rc = write_text(dir, "comparisons.csv", tcb_rpt_write_cmp_csv, r, err)))
         return rc;
+    /* the plots are of pairs: a block of clips alone has none to draw */
     for (int k = 0; k < r->n_blocks && !rc; k++)
-        if (!(rc = write_plot(dir, "pck", tcb_rpt_plot_pck, &r->blocks[k], err)) &&
+        if (r->blocks[k].n_pairs_max > 0 && !(rc = write_plot(dir, "pck", tcb_rpt_plot_pck, &r->blocks[k], err)) &&
             !(rc = write_plot(dir, "pck_geo", tcb_rpt_plot_pck_geo, &r->blocks[k], err)))
             rc = write_plot(dir, "gap", tcb_rpt_plot_gap, &r->blocks[k], err);
     return rc;

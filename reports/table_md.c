@@ -221,7 +221,7 @@ static void write_dataset(FILE *f, const tcb_rpt *r, const tcb_rpt_dataset *d)
                 b->role, pairs, b->seeds);
         write_table(f, b, shown);
         write_seed_table(f, b, shown);
-        write_plot_links(f, b);
+        if (b->n_pairs_max > 0) write_plot_links(f, b);
     }
     if (!d->n_test) {
         fprintf(f, "### %s / MEAN\n\nNo test sequence in this run: no MEAN block.\n\n", d->name);
