@@ -112,6 +112,15 @@ static const char *verdict(const tcb_cmp_metric *m, int metric)
     return a_lower == tcb_rpt_metrics[metric].lower_is_better ? "A better (significant)" : "B better (significant)";
 }
 
+/* The metric's name padded to 16 columns: counted in characters, not bytes
+ * ("×" is two bytes of UTF-8), so the numbers line up under each other. */
+static void metric_label(FILE *f, const char *label)
+{
+    int width = 0;
+    for (const unsigned char *c = (const unsigned char *)label; *c; c++) width += (*c & 0xc0) != 0x80;
+    fprintf(f, "%s%*s", label, width < 16 ? 16 - width : 0, "");
+}
+
 static void print_result(FILE *f, const target *t, const tcb_cmp *c)
 {
     fprintf(f, "A = %s, B = %s on %s/%s: %s\n", t->a, t->b, t->dataset, t->sequence,
@@ -135,22 +144,23 @@ static void print_result(FILE *f, const target *t, const tcb_cmp *c)
     fprintf(f, "95 %% interval: percentile bootstrap, %d resamples, seed %u; p: two-sided Wilcoxon signed-rank on "
                "the %s differences, not adjusted (one comparison; a report's tables adjust with Holm)\n\n",
             c->resamples, TCB_CMP_SEED, c->over_sequences ? "per-sequence" : "seed-averaged per-pair");
-    fprintf(f, "%-12s %10s %10s %10s  %-22s %-9s %s\n", "metric", "A", "B", "A - B", "95 % interval", "p",
-            "verdict");
+    metric_label(f, "metric");
+    fprintf(f, " %10s %10s %10s  %-22s %-9s %s\n", "A", "B", "A - B", "95 % interval", "p", "verdict");
     for (int m = 0; m < TCB_CMP_N_METRICS; m++) {
         const tcb_cmp_metric *x = &c->m[m];
         int d = tcb_rpt_metrics[m].decimals;
         if (!x->has) {
-            fprintf(f, "%-12s %10s %10s %10s  %-22s %-9s %s\n", tcb_cmp_metric_label(m), "-", "-", "-", "-", "-",
-                    "not compared: a side has no value");
+            metric_label(f, tcb_cmp_metric_label(m));
+            fprintf(f, " %10s %10s %10s  %-22s %-9s %s\n", "-", "-", "-", "-", "-", "not compared: a side has no value");
             continue;
         }
         char iv[64], p[32];
         snprintf(iv, sizeof iv, "[%.*f, %.*f]", d + 1, x->lo, d + 1, x->hi);
         if (isnan(x->p)) snprintf(p, sizeof p, "no test");
         else snprintf(p, sizeof p, "%.2g", x->p);
-        fprintf(f, "%-12s %10.*f %10.*f %10.*f  %-22s %-9s %s\n", tcb_cmp_metric_label(m), d, x->mean_a, d,
-                x->mean_b, d + 1, x->diff, iv, p, isnan(x->p) ? "no difference" : verdict(x, m));
+        metric_label(f, tcb_cmp_metric_label(m));
+        fprintf(f, " %10.*f %10.*f %10.*f  %-22s %-9s %s\n", d, x->mean_a, d, x->mean_b, d + 1, x->diff, iv, p,
+                isnan(x->p) ? "no difference" : verdict(x, m));
     }
 }
 
