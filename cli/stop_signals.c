@@ -8,6 +8,7 @@
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
+#include <time.h>
 
 #include "cli/stop_signals.h"
 
@@ -48,12 +49,28 @@ int tcb_stop_signals_requested(const void *arg)
     return atomic_load(&((tcb_stop_signals *)s)->signal);
 }
 
+/* A stop often comes twice, and the second can arrive after the run has
+ * ended: unblocked with its default action it would kill the process before
+ * it reports the saved state and exits 75 (a cancelled Slurm task died so of
+ * its batch shell's USR1). So what is pending counts as a request too, and
+ * once a stop was requested the signals stay ignored: the process is
+ * stopping already. Without one, they act as before the run. */
 void tcb_stop_signals_end(tcb_stop_signals *s)
 {
     if (!s->started) return;
     atomic_store(&s->closing, 1);
     pthread_kill(s->thread, SIGUSR1);
     pthread_join(s->thread, NULL);
+    const struct timespec now = {0, 0};
+    for (int sig; (sig = sigtimedwait(&s->set, NULL, &now)) > 0;) {
+        int none = 0;
+        atomic_compare_exchange_strong(&s->signal, &none, sig);
+    }
+    if (atomic_load(&s->signal)) {
+        struct sigaction ignore = {.sa_handler = SIG_IGN};
+        sigaction(SIGTERM, &ignore, NULL);
+        sigaction(SIGUSR1, &ignore, NULL);
+    }
     pthread_sigmask(SIG_SETMASK, &s->old, NULL);
     s->started = 0;
 }

@@ -11,7 +11,9 @@
  * blocks them in the calling thread (call it before any other thread
  * exists) and starts the thread that waits for them; requested() is the
  * signal received, 0 before one (a tcb_run_opts.interrupted); end restores
- * the mask. */
+ * the mask, and once a stop was requested (or one is pending) leaves
+ * SIGTERM and SIGUSR1 ignored, so that a late second one cannot kill the
+ * process on its way out. */
 typedef struct tcb_stop_signals {
     sigset_t set, old;
     pthread_t thread;
