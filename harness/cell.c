@@ -71,6 +71,7 @@ int tcb_cell_identity(const tcb_cell_job *job, tcb_cell_result *c, tcb_error *he
     }
     snprintf(c->git_revision, sizeof c->git_revision, "%s", job->git_revision);
     snprintf(c->split_path, sizeof c->split_path, "%s", job->split_path);
+    c->no_faces = job->seq->n_faces == 0;
     c->seed = job->seed;
     c->split_seed = job->split->seed;
     c->load_s = job->load_s;

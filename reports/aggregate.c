@@ -19,9 +19,10 @@ const tcb_rpt_metric_def tcb_rpt_metrics[TCB_N_METRICS] = {
     /* ×1e3 as m_sL2 (the papers print it raw: their 0.010 is 10.00 here). */
     {"corr", "Corr ↓", "Corr $\\downarrow$", 1e3, 2, 1, 0},
     {"corr_mesh", "Corr-mesh ↓", "Corr-mesh $\\downarrow$", 1e3, 2, 1, 0},
-    /* The reconstruction metrics: CD-L2 ×1e3 as CD, NC and F-score as
-     * percentages (the papers print them raw: their 0.95 is 95.00 here). */
-    {"cdl2", "CD-L2 ↓", "CD-L2 $\\downarrow$", 1e3, 3, 1, 0},
+    /* The reconstruction metrics: CD-L2 ×1e5 as the papers print it (their
+     * 0.44 is 0.44 here), NC and F-score as percentages (the papers print
+     * them raw: their 0.95 is 95.00 here). */
+    {"cdl2", "CD-L2 ↓", "CD-L2 $\\downarrow$", 1e5, 2, 1, 0},
     {"nc", "NC ↑", "NC $\\uparrow$", 1e2, 2, 0, 0},
     {"fscore05", "F@0.5% ↑", "F@0.5\\% $\\uparrow$", 1e2, 2, 0, 0},
     {"fscore1", "F@1% ↑", "F@1\\% $\\uparrow$", 1e2, 2, 0, 0},
@@ -122,6 +123,7 @@ static int build_row(const tcb_cell_result *cells, int n, tcb_rpt_row *r, tcb_er
     snprintf(r->method, sizeof r->method, "%s", cells[0].method);
     snprintf(r->method_impl, sizeof r->method_impl, "%s", cells[0].method_impl);
     snprintf(r->normals, sizeof r->normals, "%s", cells[0].normals);
+    r->no_faces = cells[0].no_faces;
     const char *params = cells[0].params_json ? cells[0].params_json : "";
     if (strlen(params) < sizeof r->params) memcpy(r->params, params, strlen(params) + 1);
     r->n_seeds = n;
@@ -343,6 +345,7 @@ static void mean_row(const tcb_rpt_block *const *tests, int nt, const char *meth
         if (t == 0) memcpy(r->method_impl, s->method_impl, sizeof r->method_impl);
         if (t == 0) memcpy(r->params, s->params, sizeof r->params);
         if (t == 0) memcpy(r->normals, s->normals, sizeof r->normals);
+        if (t == 0) r->no_faces = s->no_faces;
         r->n_pairs += s->n_pairs;
         for (int m = 0; m < TCB_N_METRICS; m++) {
             r->has[m] &= s->has[m];

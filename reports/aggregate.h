@@ -8,7 +8,7 @@
  * hides behind a number. The geodesic columns (tcb/geodesic.h, not the
  * paper's) show "-" unless every pooled pair has them: a cell written
  * before the geodesic error existed has none. Corr (×1e3, the clip
- * protocol's) shows "-" for cells that scored no clips; CD-L2 (×1e3), NC
+ * protocol's) shows "-" for cells that scored no clips; CD-L2 (×1e5), NC
  * and the F-scores (%) "-" for methods without surfaces and older cells. */
 #ifndef TCB_REPORTS_AGGREGATE_H
 #define TCB_REPORTS_AGGREGATE_H
@@ -73,6 +73,8 @@ typedef struct tcb_rpt_row {
     char params[256];                 /* that cell's params, compact JSON ("" when longer) */
     char normals[16];                 /* the normals its first cell's method took ("gt",
                                        * "estimated"; "" points only: tcb_cell_result.normals) */
+    int no_faces;                     /* its first cell's sequence has no faces (MEAN rows:
+                                       * the first test sequence's): tcb_cell_result.no_faces */
     const char *status;               /* "ok", "failed", "diverged" or "missing" */
     char status_text[64];             /* status plus how many pooled parts had it */
     char message[TCB_ERRMSG_MAX];     /* first failing cell: "seed 1: …" */

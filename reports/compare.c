@@ -24,7 +24,7 @@ const char *tcb_cmp_metric_label(int metric)
 {
     static const char *const labels[TCB_CMP_N_METRICS] = {"m_sL2 ×1e3", "rank %",     "AUC %",   "CD ×1e3",
                                                           "m_geo ×1e3", "AUC_geo %", "Corr ×1e3",
-                                                          "Corr-mesh ×1e3", "CD-L2 ×1e3", "NC %",      "F@0.5% %", "F@1% %"};
+                                                          "Corr-mesh ×1e3", "CD-L2 ×1e5", "NC %",      "F@0.5% %", "F@1% %"};
     return labels[metric];
 }
 

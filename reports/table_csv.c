@@ -90,7 +90,7 @@ void tcb_rpt_write_csv(FILE *f, const tcb_rpt *r)
           "rank_pct_mean,rank_pct_std,auc_pct_mean,auc_pct_std,cd_x1e3_mean,cd_x1e3_std,"
           "sl2sq_x1e3_mean,sl2sq_x1e3_std,geo_x1e3_mean,geo_x1e3_std,geo_auc_pct_mean,"
           "geo_auc_pct_std,geo_unreachable,corr_x1e3_mean,corr_x1e3_std,sl2_mark,rank_mark,auc_mark,"
-          "cd_mark,geo_mark,geo_auc_mark,corr_mark,cdl2_x1e3_mean,cdl2_x1e3_std,nc_pct_mean,nc_pct_std,"
+          "cd_mark,geo_mark,geo_auc_mark,corr_mark,cdl2_x1e5_mean,cdl2_x1e5_std,nc_pct_mean,nc_pct_std,"
           "fscore05_pct_mean,fscore05_pct_std,fscore1_pct_mean,fscore1_pct_std,cdl2_mark,nc_mark,fscore05_mark,"
           "fscore1_mark,corr_mesh_x1e3_mean,corr_mesh_x1e3_std,corr_mesh_mark\n",
           f);
@@ -124,7 +124,7 @@ void tcb_rpt_write_gap_csv(FILE *f, const tcb_rpt *r)
 void tcb_rpt_write_seed_csv(FILE *f, const tcb_rpt *r)
 {
     fputs("dataset,sequence,role,method,seed,status,n_pairs,sl2_x1e3_mean,rank_pct_mean,"
-          "auc_pct_mean,cd_x1e3_mean,geo_x1e3_mean,geo_auc_pct_mean,corr_x1e3_mean,cdl2_x1e3_mean,nc_pct_mean,"
+          "auc_pct_mean,cd_x1e3_mean,geo_x1e3_mean,geo_auc_pct_mean,corr_x1e3_mean,cdl2_x1e5_mean,nc_pct_mean,"
           "fscore05_pct_mean,fscore1_pct_mean,corr_mesh_x1e3_mean\n",
           f);
     for (int k = 0; k < r->n_blocks; k++)

@@ -59,6 +59,19 @@ static void write_normals_note(FILE *f, const tcb_rpt_block *b)
     fprintf(f, with < b->n_rows ? "; the other methods took points only.\n" : ".\n");
 }
 
+/* A sequence of points alone: its geodesic and reconstruction columns are
+ * missing because they do not apply, not because a method failed them. */
+static void write_faces_note(FILE *f, const tcb_rpt_block *b)
+{
+    if (!b->n_rows) return;
+    for (int k = 0; k < b->n_rows; k++)
+        if (!b->rows[k].no_faces) return;
+    fprintf(f, "\nNot applicable: the geodesic error (m_geo, AUC_geo) and the reconstruction metrics (CD-L2, "
+               "NC, F-score): %s no faces, points alone (docs/datasets.md, \"pcl_seq\"); CD is measured "
+               "against those points.\n",
+            strcmp(b->role, "mean") ? "the sequence has" : "the test sequences have");
+}
+
 /* atlasnet and mca rows with the same params whose m_sL2 agree within 1 %:
  * a reader takes that for a bug (one method run twice) unless told why.
  * The two start from the same weights and draw the same batches (the
@@ -144,6 +157,7 @@ static void write_table(FILE *f, const tcb_rpt_block *b, const unsigned char *sh
     }
     write_marks_legend(f, b);
     write_normals_note(f, b);
+    write_faces_note(f, b);
     write_unreachable_note(f, b);
     write_twin_note(f, b);
     fprintf(f, "\n");
@@ -246,7 +260,7 @@ void tcb_rpt_write_md(FILE *f, const tcb_rpt *r)
                "PCK up to 0.25, over pairs); \"-\" there: cells scored before it existed. Corr ×1e3: the "
                "clip protocol's tracking error, over clips; Corr-mesh ×1e3: the same as DynoSurf's script "
                "computes it, from the method's surfaces of one topology (docs/protocol.md). A column no "
-               "method of a dataset has is left out. CD-L2 ×1e3, NC %% and F-score %% at 0.5 %% and "
+               "method of a dataset has is left out. CD-L2 ×1e5 (as the papers), NC %% and F-score %% at 0.5 %% and "
                "1 %% (F@0.5%%, F@1%%): the reconstruction metrics of DynoSurf's evaluation, over the "
                "evaluated frames; \"-\" there: the method gives no surface (or its cells predate them).\n\n");
     tcb_rpt_write_presets_md(f, r);

@@ -16,7 +16,7 @@ static const char *const TOP_KEYS[] = {
     "format",       "dataset",         "sequence", "role",        "method",
     "method_impl",  "params",          "seed",     "status",      "message",
     "git_revision", "tcbench_version", "timings",  "peak_rss_kb", "split",
-    "summary",      "pair_columns",    "pairs",    "clips",       "surface", "plugin", "normals", NULL};
+    "summary",      "pair_columns",    "pairs",    "clips",       "surface", "plugin", "normals", "faces", NULL};
 static const char *const TIMING_KEYS[] = {"load_s", "fit_s", "eval_s", NULL};
 static const char *const SPLIT_KEYS[] = {"path", "seed", "n_pairs", NULL};
 static const char *const PLUGIN_KEYS[] = {"path", "fnv1a64", "abi", "version", NULL};
@@ -474,13 +474,23 @@ static int load_normals(const cJSON *root, const char *where, tcb_cell_result *c
     return rc;
 }
 
+/* "faces": false, when the sequence has none (absent: it has faces, or a
+ * cell written before the key). */
+static int load_faces(const cJSON *root, const char *where, tcb_cell_result *c, tcb_error *err)
+{
+    int faces;
+    int rc = tcb_json_bool(root, "faces", where, 0, 1, &faces, err);
+    if (!rc) c->no_faces = !faces;
+    return rc;
+}
+
 static int cell_from_json(const cJSON *root, const char *path, tcb_cell_result *c,
                           tcb_error *err)
 {
     int n_cols;
     int rc = tcb_json_expect_object(root, path, err);
     if (rc || (rc = load_header(root, path, c, err)) || (rc = load_plugin(root, path, c, err)) ||
-        (rc = load_normals(root, path, c, err)) ||
+        (rc = load_normals(root, path, c, err)) || (rc = load_faces(root, path, c, err)) ||
         (rc = load_params(root, path, c, err)) ||
         (rc = load_timings_split(root, path, c, err)) ||
         (rc = load_summary(root, path, &c->summary, err)) ||

@@ -297,6 +297,7 @@ cJSON *tcb_cell_to_json(const char *path, const tcb_cell_result *c, tcb_error *e
         }
     }
     if (c->normals[0]) add_str(&b, root, "normals", c->normals);
+    if (c->no_faces) add(&b, root, "faces", cJSON_CreateBool(0));
     add_summary(&b, root, &c->summary);
     add_pairs(&b, root, c);
     add_clips(&b, root, c);

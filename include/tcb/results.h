@@ -59,6 +59,10 @@
  * none (plugin_path "").
  * A cell whose method took normals with its input points says which:
  * "normals": "gt" | "estimated" (absent: points only, or written before).
+ * A cell of a sequence without faces (a "pcl_seq" dataset: points alone)
+ * says so, "faces": false (absent: the sequence has faces, or the cell was
+ * written before the key): its geodesic and reconstruction metrics are not
+ * applicable, and reports say so instead of leaving their columns blank.
  * The reconstruction metrics (tcb/metrics.h, TCB_RECON_*; docs/protocol.md,
  * "Reconstruction metrics") came later too: a cell whose method gives
  * surfaces has "summary.cdl2", "summary.nc", "summary.fscore05" and
@@ -124,6 +128,7 @@ typedef struct tcb_cell_result {
     char plugin_version[64];   /* and its version string (tcb_method_ops.version; "" none) */
     char normals[16];          /* the normals the method took with its input points
                                 * (tcb_method_normals: "gt", "estimated"); "" none */
+    int no_faces;              /* 1: the sequence has no faces ("faces": false) */
     char *params_json;         /* malloc'ed, compact JSON object */
     int seed;
     tcb_cell_status status;

@@ -56,6 +56,7 @@ for m in ("nearest", "nricp", "neupig", "mca"):
     c = json.load(open("run/cells/toy/blob/%s/seed_0.json" % m))
     assert c["status"] == "ok", (m, c["message"])
     assert c["summary"]["geo"]["n"] == 0 and "surface" not in c, (m, "a metric that needs faces")
+    assert c["faces"] is False, (m, "a faceless sequence not said so")
     assert all(p[11] is None for p in c["pairs"]), (m, "a geodesic error per pair")
     assert c["summary"]["sl2"]["n"] > 0 and c["summary"]["corr"]["n"] == 2, m
 c = json.load(open("run/cells/toy/blob/nearest/seed_0.json"))
@@ -66,6 +67,9 @@ for start, corr, err in (r[:3] for r in c["clips"]["rows"]):
     assert abs(corr - np.mean(want)) <= 1e-6 * np.mean(want)
 head = [l for l in open("run/report/tables.md") if l.startswith("| method |")][0]
 assert "m_geo" not in head and "CD-L2" not in head and "Corr ↓" in head, head
+md = open("run/report/tables.md").read()
+na = "Not applicable: the geodesic error (m_geo, AUC_geo) and the reconstruction metrics (CD-L2, NC, F-score): "
+assert md.count(na + "the sequence has no faces") == 1 and md.count(na + "the test sequences have no faces") == 1, md
 print("pcl_seq: world coordinates as numpy reads them; no metric that needs faces")
 PY
 

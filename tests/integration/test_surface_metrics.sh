@@ -123,23 +123,25 @@ for k, key in enumerate(keys, 1):
     assert abs(st["m2"] - ((x - x.mean()) ** 2).sum()) <= 1e-9 * max(st["m2"], 1e-30), (key, st)
 assert (rows[:, 1] > 0).all() and (rows[:, 2:] >= 0).all() and (rows[:, 2:] <= 1).all(), rows
 assert cell("again", "mca")["surface"] == surf, "not reproducible"
+assert "faces" not in c, "a sequence with faces said to have none"
 n = cell("run", "nearest")
 assert "surface" not in n and not any(k in n["summary"] for k in keys), n["summary"].keys()
 table = {r["method"]: r for r in csv.DictReader(open("run/report/results.csv")) if r["sequence"] != "MEAN"}
-scale = {"cdl2": (1e3, 3), "nc": (1e2, 2), "fscore05": (1e2, 2), "fscore1": (1e2, 2)}
+scale = {"cdl2": (1e5, 2), "nc": (1e2, 2), "fscore05": (1e2, 2), "fscore1": (1e2, 2)}
 for key, (f, d) in scale.items():
-    col = "%s_%s_mean" % (key, "x1e3" if f == 1e3 else "pct")
+    col = "%s_%s_mean" % (key, "x1e5" if f == 1e5 else "pct")
     assert table["mca"][col] == "%.*f" % (d, c["summary"][key]["mean"] * f), (col, table["mca"][col])
     assert table["nearest"][col] == "", (col, table["nearest"][col])
 # compare: the frames are the units, A - B is the difference of their means
 short = np.array(cell("run", "mca_short")["surface"]["rows"], dtype=float)
 text = open("compare.txt").read()
 assert "paired over the %d evaluated frames" % len(frames) in text, text
-line = next(l for l in text.splitlines() if l.startswith("CD-L2 ×1e3"))
+line = next(l for l in text.splitlines() if l.startswith("CD-L2 ×1e5"))
 diff = float(line.split()[4])
-assert abs(diff - (rows[:, 1] - short[:, 1]).mean() * 1e3) < 1e-3, (line, (rows[:, 1] - short[:, 1]).mean() * 1e3)
+assert abs(diff - (rows[:, 1] - short[:, 1]).mean() * 1e5) < 1e-3, (line, (rows[:, 1] - short[:, 1]).mean() * 1e5)
 print("run: %d frames scored for mca, none for nearest; reproducible; results.csv and compare agree" % len(frames))
 PY
 grep -E '^\| nearest \|' run/report/tables.md | grep -qE '\| - \| - \| - \| - \|$' ||
     { echo "FAIL: nearest's reconstruction columns are not -"; cat run/report/tables.md; exit 1; }
+! grep -q "Not applicable" run/report/tables.md || { echo "FAIL: metrics of a mesh called not applicable"; exit 1; }
 echo "surface metrics test passed"

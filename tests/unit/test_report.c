@@ -397,7 +397,7 @@ static void test_csv_parses_back(void **state)
      * marks, the reconstruction metrics and their marks after them) */
     static const struct { int at; const char *name; } cols[] = {
         {7, "sl2_x1e3_mean"},   {15, "sl2sq_x1e3_mean"},  {17, "geo_x1e3_mean"},   {21, "geo_unreachable"},
-        {22, "corr_x1e3_mean"}, {24, "sl2_mark"},         {30, "corr_mark"},       {31, "cdl2_x1e3_mean"},
+        {22, "corr_x1e3_mean"}, {24, "sl2_mark"},         {30, "corr_mark"},       {31, "cdl2_x1e5_mean"},
         {33, "nc_pct_mean"},    {35, "fscore05_pct_mean"}, {37, "fscore1_pct_mean"}, {39, "cdl2_mark"},
         {42, "fscore1_mark"},     {43, "corr_mesh_x1e3_mean"}, {45, "corr_mesh_mark"}};
     for (size_t k = 0; k < sizeof cols / sizeof *cols; k++) assert_string_equal(rows[0].field[cols[k].at], cols[k].name);
@@ -488,7 +488,7 @@ static void test_seed_csv_one_row_per_cell(void **state)
     fixture *f = *state;
     int n;
     csv_row *rows = read_csv(f, "seeds.csv", 19, &n);
-    assert_string_equal(rows[0].field[14], "cdl2_x1e3_mean");
+    assert_string_equal(rows[0].field[14], "cdl2_x1e5_mean");
     assert_string_equal(rows[0].field[17], "fscore1_pct_mean");
     assert_string_equal(rows[0].field[18], "corr_mesh_x1e3_mean");
     assert_string_equal(rows[0].field[4], "seed");
