@@ -128,6 +128,34 @@ int tcb_poisson_reconstruct(const float *pts, const float *normals, int n, int d
     return rc;
 }
 
+int tcb_mesh_remesh(const tcb_mesh *in, double edge_length, int iterations, tcb_mesh *out, tcb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    int rc = check_mesh(in, err);
+    if (rc) return rc;
+    if (!(edge_length > 0) || !isfinite(edge_length))
+        return tcb_fail(err, TCB_ERR_INPUT, "meshing: a target edge length of %g (need a positive length)",
+                        edge_length);
+    if (iterations < 1 || iterations > TCB_REMESH_ITERATIONS_MAX)
+        return tcb_fail(err, TCB_ERR_INPUT, "meshing: %d remeshing iterations (need 1 to %d)", iterations,
+                        TCB_REMESH_ITERATIONS_MAX);
+    /* More faces than the input's area allows at this length is a length
+     * far too short for the mesh, not a remeshing. */
+    double area = tcb_mesh_area(in->verts, in->faces, in->n_faces);
+    double faces = area / (0.4330127 * edge_length * edge_length); /* equilateral: √3/4 h² */
+    if (faces > TCB_REMESH_FACES_MAX)
+        return tcb_fail(err, TCB_ERR_INPUT,
+                        "meshing: remeshing to edge length %g would make about %.0f triangles (at most %d)",
+                        edge_length, faces, TCB_REMESH_FACES_MAX);
+    backend b;
+    if ((rc = backend_open(&b, err))) return rc;
+    rc = b.ops->remesh(in, edge_length, iterations, out, err);
+    backend_close(&b);
+    if (!rc) rc = check_result(out, "isotropic remeshing", err);
+    if (rc) tcb_mesh_free(out);
+    return rc;
+}
+
 int tcb_mesh_decimate(const tcb_mesh *in, int max_faces, tcb_mesh *out, tcb_error *err)
 {
     memset(out, 0, sizeof *out);

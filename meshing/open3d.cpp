@@ -1,30 +1,21 @@
-// The meshing backend: tcbench's C calls turned into Open3D 0.16 calls, and
-// Open3D's exceptions turned back into a tcb_error (none may cross into C).
-// Built as the module libtcbench_meshing.so, which meshing/meshing.c loads
-// when a meshing function is first called; inputs arrive checked.
+// The Open3D half of the meshing module: tcbench's C calls turned into
+// Open3D 0.16 calls (screened Poisson, quadric decimation, PCA normals).
+// Inputs arrive checked by meshing/meshing.c.
 #include <open3d/geometry/KDTreeSearchParam.h>
 #include <open3d/geometry/PointCloud.h>
 #include <open3d/geometry/TriangleMesh.h>
 #include <open3d/utility/Logging.h>
 
-#include <algorithm>
 #include <cstdlib>
-#include <cstring>
-#include <exception>
 #include <limits>
 #include <memory>
-#include <new>
 
-#include "meshing/backend.h"
+#include "meshing/module.h"
 
 namespace {
 
 using open3d::geometry::PointCloud;
 using open3d::geometry::TriangleMesh;
-
-// Open3D reports through exceptions and prints warnings; a library of
-// tcbench never prints, so only errors (thrown, then caught below) remain.
-void quiet() { open3d::utility::SetVerbosityLevel(open3d::utility::VerbosityLevel::Error); }
 
 PointCloud make_cloud(const float *pts, const float *normals, int n)
 {
@@ -39,49 +30,32 @@ PointCloud make_cloud(const float *pts, const float *normals, int n)
     return pc;
 }
 
-// Copies Open3D's mesh into a malloc'ed tcb_mesh (the caller frees it with
-// tcb_mesh_free).
+// Copies Open3D's mesh into a malloc'ed tcb_mesh.
 int to_tcb_mesh(const TriangleMesh &m, tcb_mesh *out, tcb_error *err)
 {
     const size_t nv = m.vertices_.size(), nf = m.triangles_.size();
-    if (nv > (size_t)std::numeric_limits<int>::max() / 3 || nf > (size_t)std::numeric_limits<int>::max() / 3)
-        return tcb_fail(err, TCB_ERR_INTERNAL, "meshing: the mesh has too many elements (%zu vertices, %zu faces)", nv,
-                        nf);
-    float *v = static_cast<float *>(std::malloc(3 * (nv ? nv : 1) * sizeof(float)));
-    int32_t *f = static_cast<int32_t *>(std::malloc(3 * (nf ? nf : 1) * sizeof(int32_t)));
-    if (!v || !f) {
-        std::free(v);
-        std::free(f);
-        return tcb_fail(err, TCB_ERR_NOMEM, "meshing: out of memory for a mesh of %zu vertices", nv);
-    }
+    int rc = tcb_meshing::alloc_mesh(nv, nf, out, err);
+    if (rc) return rc;
     for (size_t i = 0; i < nv; i++)
-        for (int d = 0; d < 3; d++) v[3 * i + d] = (float)m.vertices_[i][d];
+        for (int d = 0; d < 3; d++) out->verts[3 * i + d] = (float)m.vertices_[i][d];
     for (size_t i = 0; i < nf; i++)
-        for (int d = 0; d < 3; d++) f[3 * i + d] = m.triangles_[i][d];
-    out->verts = v;
-    out->faces = f;
-    out->n_verts = (int)nv;
-    out->n_faces = (int)nf;
+        for (int d = 0; d < 3; d++) out->faces[3 * i + d] = m.triangles_[i][d];
     return TCB_OK;
 }
 
-// Runs one Open3D call; what it throws becomes a one-line tcb_error.
-template <class F> int guarded(const char *what, tcb_error *err, F &&call)
+// Open3D reports through exceptions and prints warnings; a library of
+// tcbench never prints, so only errors (thrown, then caught) remain.
+template <class F> int open3d_call(const char *what, tcb_error *err, F &&call)
 {
-    try {
-        quiet();
+    return tcb_meshing::guarded("Open3D", what, err, [&] {
+        open3d::utility::SetVerbosityLevel(open3d::utility::VerbosityLevel::Error);
         return call();
-    } catch (const std::bad_alloc &) {
-        return tcb_fail(err, TCB_ERR_NOMEM, "meshing: %s: out of memory", what);
-    } catch (const std::exception &e) {
-        // Qhull's errors run to twenty lines: the first says what failed.
-        const char *msg = e.what();
-        return tcb_fail(err, TCB_ERR_NUMERIC, "meshing: %s failed in Open3D: %.*s", what,
-                        (int)std::min<size_t>(std::strcspn(msg, "\n"), 200), msg);
-    } catch (...) {
-        return tcb_fail(err, TCB_ERR_INTERNAL, "meshing: %s failed in Open3D (unknown exception)", what);
-    }
+    });
 }
+
+} // namespace
+
+namespace tcb_meshing {
 
 // Open3D's defaults but for depth and threads: width 0 (depth decides),
 // scale 1.1 (the cube around the points; MeshLab's default too), no linear
@@ -89,7 +63,7 @@ template <class F> int guarded(const char *what, tcb_error *err, F &&call)
 // vertex order depends on the thread count).
 int poisson(const float *pts, const float *normals, int n, int depth, tcb_mesh *out, tcb_error *err)
 {
-    return guarded("screened Poisson", err, [&] {
+    return open3d_call("screened Poisson", err, [&] {
         PointCloud pc = make_cloud(pts, normals, n);
         auto result = TriangleMesh::CreateFromPointCloudPoisson(pc, (size_t)depth, 0.0f, 1.1f, false, 1);
         return to_tcb_mesh(*std::get<0>(result), out, err);
@@ -100,7 +74,7 @@ int poisson(const float *pts, const float *normals, int n, int depth, tcb_mesh *
 // (simplify_quadric_decimation(target)): no error bound, boundary weight 1.
 int decimate(const tcb_mesh *in, int max_faces, tcb_mesh *out, tcb_error *err)
 {
-    return guarded("quadric decimation", err, [&] {
+    return open3d_call("quadric decimation", err, [&] {
         TriangleMesh m;
         m.vertices_.resize(in->n_verts);
         m.triangles_.resize(in->n_faces);
@@ -124,7 +98,7 @@ int decimate(const tcb_mesh *in, int max_faces, tcb_mesh *out, tcb_error *err)
 // k-NN graph.
 int normals(const float *pts, int n, int k, float *out, tcb_error *err)
 {
-    return guarded("normal estimation", err, [&] {
+    return open3d_call("normal estimation", err, [&] {
         PointCloud pc = make_cloud(pts, nullptr, n);
         pc.EstimateNormals(open3d::geometry::KDTreeSearchParamKNN(k), false);
         pc.OrientNormalsConsistentTangentPlane((size_t)k);
@@ -136,8 +110,4 @@ int normals(const float *pts, int n, int k, float *out, tcb_error *err)
     });
 }
 
-const tcb_meshing_ops ops = {poisson, decimate, normals};
-
-} // namespace
-
-extern "C" __attribute__((visibility("default"))) const tcb_meshing_ops *tcb_meshing_backend(void) { return &ops; }
+} // namespace tcb_meshing

@@ -15,6 +15,8 @@ packages=(
   zlib1g-dev                              # .npz results files (deflate, CRC-32)
   libopenblas-openmp-dev                  # dense linear algebra (the OpenMP build: one thread pool)
   libopen3d-dev                           # meshing/: screened Poisson, quadric decimation, normals (Open3D 0.16)
+  libsuitesparse-dev                      # meshing/: CHOLMOD's sparse Cholesky (Large-Steps systems)
+  libcgal-dev                             # meshing/: CGAL's isotropic remeshing (PDG's template)
   libcmocka-dev                           # unit-test framework
   python3 python3-numpy python3-scipy     # tests: JSON comparisons, scipy reference for linear assignment
   python3-pip python3-venv python3-setuptools python3-wheel  # `pip install .` of the Python binding, offline

@@ -52,6 +52,19 @@ int tcb_poisson_reconstruct(const float *pts, const float *normals, int n, int d
  * are dropped. */
 int tcb_mesh_decimate(const tcb_mesh *in, int max_faces, tcb_mesh *out, tcb_error *err);
 
+/* The mesh remeshed toward edges of length edge_length (> 0) by
+ * Botsch & Kobbelt's isotropic remeshing (CGAL's Polygon Mesh Processing:
+ * split edges longer than 4/3·h, collapse those shorter than 4/5·h, flip
+ * toward valence 6, tangential smoothing, projection back onto the input),
+ * `iterations` rounds (1 to TCB_REMESH_ITERATIONS_MAX). The input is taken
+ * as a triangle soup and repaired first (duplicate points merged,
+ * degenerate faces dropped, orientation made consistent, non-manifold
+ * vertices split); border edges stay on the border. A length that would
+ * make more than TCB_REMESH_FACES_MAX triangles is refused. */
+#define TCB_REMESH_ITERATIONS_MAX 100
+#define TCB_REMESH_FACES_MAX 2000000
+int tcb_mesh_remesh(const tcb_mesh *in, double edge_length, int iterations, tcb_mesh *out, tcb_error *err);
+
 /* Unit normals [n][3] of n ≥ 4 points: the least-variance axis of each
  * point's k nearest neighbours (3 ≤ k, capped at n), oriented consistently
  * by propagation along a minimum spanning tree of the k-NN graph, and

@@ -1,7 +1,8 @@
-/* Keyframe meshing through the Open3D module: screened Poisson on a sphere
- * and on a synthetic body (closed, outward, on the true surface),
- * decimation (budget, closedness, distance), estimated normals against the
- * true ones, and bad input. */
+/* Keyframe meshing through the geometry module: screened Poisson on a
+ * sphere and on a synthetic body (closed, outward, on the true surface),
+ * decimation (budget, closedness, distance), isotropic remeshing (edge
+ * lengths against the target), estimated normals against the true ones, and
+ * bad input. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -303,6 +304,82 @@ static void test_normals_body(void **state)
     free(n);
 }
 
+/* ---- isotropic remeshing (CGAL) ------------------------------------------- */
+
+/* Edge lengths of a mesh, each edge once: mean, and the fraction within
+ * [lo, hi]. */
+static void edge_stats(const tcb_mesh *m, double lo, double hi, double *mean, double *inside)
+{
+    double sum = 0;
+    int n = 0, in = 0;
+    for (int f = 0; f < m->n_faces; f++)
+        for (int k = 0; k < 3; k++) {
+            int a = m->faces[3 * f + k], b = m->faces[3 * f + (k + 1) % 3];
+            if (a > b) continue; /* a closed, oriented mesh has each edge once each way */
+            const float *p = m->verts + 3 * a, *q = m->verts + 3 * b;
+            double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2], len = sqrt(dx * dx + dy * dy + dz * dz);
+            sum += len;
+            in += len >= lo && len <= hi;
+            n++;
+        }
+    *mean = sum / n;
+    *inside = (double)in / n;
+}
+
+/* The largest distance from m's vertices to the surface `on`. */
+static double max_distance_to(const tcb_mesh *on, const tcb_mesh *m)
+{
+    tcb_surface_point *loc = malloc((size_t)m->n_verts * sizeof *loc);
+    float *d2 = tu_falloc((size_t)m->n_verts);
+    tcb_error err = {0};
+    assert_non_null(loc);
+    if (tcb_mesh_locate(on->verts, on->n_verts, on->faces, on->n_faces, m->verts, m->n_verts, loc, d2, &err))
+        fail_msg("%s", err.msg);
+    double worst = 0;
+    for (int i = 0; i < m->n_verts; i++) worst = fmax(worst, d2[i]);
+    free(d2);
+    free(loc);
+    return sqrt(worst);
+}
+
+/* A decimated Poisson sphere (edges of every length) remeshed toward h:
+ * its edges gather around h (Botsch & Kobbelt split above 4/3·h and
+ * collapse below 4/5·h, and smoothing evens the rest), it stays closed,
+ * outward and on the sphere, with about the equilateral face count. */
+static void test_remesh_sphere(void **state)
+{
+    (void)state;
+    float *p = sphere_points(KEYFRAME_POINTS, 5);
+    tcb_mesh m, d, r;
+    poisson_ok(p, p, KEYFRAME_POINTS, TEST_DEPTH, &m);
+    decimate_ok(&m, 1000, &d);
+    const double h = 0.1;
+    double mean0, inside0, mean, inside, wide;
+    edge_stats(&d, 0.8 * h, 4.0 / 3.0 * h, &mean0, &inside0);
+    tcb_error err = {0};
+    if (tcb_mesh_remesh(&d, h, 10, &r, &err)) fail_msg("remesh: %s", err.msg);
+    edge_stats(&r, 0.5 * h, 1.6 * h, &mean, &wide);
+    edge_stats(&r, 0.8 * h, 4.0 / 3.0 * h, &mean, &inside);
+    double off = max_distance_to(&d, &r);
+    double faces = 4 * M_PI / (sqrt(3.0) / 4 * h * h);
+    print_message("remeshed %d -> %d faces (equilateral: %.0f); edge mean %.4f -> %.4f (h %.2f), within [4/5 h, 4/3 h] "
+                  "%.3f -> %.3f, within [h/2, 1.6 h] %.4f; farthest vertex from the input %.2g\n",
+                  d.n_faces, r.n_faces, faces, mean0, mean, h, inside0, inside, wide, off);
+    assert_true(tu_closed_oriented(r.faces, r.n_faces));
+    assert_true(signed_volume(&r) > 0);
+    /* measured: mean 0.924 h, 85 % within [4/5 h, 4/3 h], all within
+     * [h/2, 1.6 h], 3372 faces (smoothing moves vertices after the splits
+     * and collapses); the vertices are projected onto the input */
+    assert_true(fabs(mean / h - 1) < 0.15);
+    assert_true(inside > 0.75 && wide > 0.99);
+    assert_true(fabs(r.n_faces / faces - 1) < 0.25);
+    assert_true(off < 1e-5);
+    tcb_mesh_free(&m);
+    tcb_mesh_free(&d);
+    tcb_mesh_free(&r);
+    free(p);
+}
+
 /* ---- bad input ----------------------------------------------------------- */
 
 static void expect(int rc, const tcb_error *err, tcb_status code, const char *part)
@@ -348,6 +425,10 @@ static void test_bad_input(void **state)
     tet.n_faces = 0;
     expect(tcb_mesh_decimate(&tet, 4, &out, &err), &err, TCB_ERR_INPUT, "empty");
     tet.n_faces = 4;
+    expect(tcb_mesh_remesh(&tet, 0.0, 5, &out, &err), &err, TCB_ERR_INPUT, "edge length of 0");
+    expect(tcb_mesh_remesh(&tet, NAN, 5, &out, &err), &err, TCB_ERR_INPUT, "edge length of nan");
+    expect(tcb_mesh_remesh(&tet, 0.5, 0, &out, &err), &err, TCB_ERR_INPUT, "0 remeshing iterations");
+    expect(tcb_mesh_remesh(&tet, 1e-4, 5, &out, &err), &err, TCB_ERR_INPUT, "would make about");
     tv[4] = INFINITY;
     expect(tcb_mesh_decimate(&tet, 4, &out, &err), &err, TCB_ERR_NUMERIC, "vertex coordinate");
     free(nrm);
@@ -373,6 +454,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_poisson_sphere),
         cmocka_unit_test(test_decimate_sphere),
+        cmocka_unit_test(test_remesh_sphere),
         cmocka_unit_test(test_normals_sphere),
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_library_error),
