@@ -13,7 +13,7 @@ the C code takes them. The frames' clouds: POINTS points of the template's
 faces per frame, turned by 0.1 rad per frame about y and jittered,
 drawn once (data loading is not part of the step). The grids start at zero
 and the last layer at zero, as in the reference; the solve is exact in the
-DCT basis (as tcbench's). The Chamfer's nearest neighbours come from the
+eigenbasis of the path matrices (as tcbench's). The Chamfer's nearest neighbours come from the
 distance matrix's GEMM form, then the distances of the matches with
 autograd (pytorch3d's knn_points does the same brute-force search).
 
@@ -80,7 +80,7 @@ def main():
     groups = [{"params": [g], "lr": 0.005 * 2.5 ** l} for l, g in enumerate(grids[:-1])]
     groups += [{"params": [grids[-1]], "lr": 0.005}, {"params": mlp, "lr": 1e-3}]
     opt = torch.optim.Adam(groups)
-    solve = nt.solvers(a, nt.dct_solver)
+    solve = nt.solvers(a, nt.basis_solver)
     epoch = [0]  # the confidence's exponent follows the epoch, as in a fit of iters + 1 epochs
 
     def step():

@@ -1,38 +1,68 @@
-/* Exact Sobolev solve on a lattice through its DCT eigenbasis
- * (neural/sobolev.h). */
+/* Exact Sobolev solve on a lattice through the eigenbasis of its path
+ * matrices (neural/sobolev.h). */
 #include "neural/sobolev.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-int tcb_sobolev_init(tcb_sobolev *s, int r, double lambda, tcb_error *err)
+const char *const tcb_sobolev_laplacian_names[] = {"pcgrid", "graph", NULL};
+
+/* LAPACK's eigensolver of a symmetric tridiagonal matrix (OpenBLAS carries
+ * LAPACK; Debian installs no LAPACKE header beside it). */
+extern void dstev_(const char *jobz, const int *n, double *d, double *e, double *z, const int *ldz, double *work,
+                   int *info);
+
+/* Q (column k the k-th eigenvector) and μ of the path matrix P. */
+static int path_eigen(int r, tcb_sobolev_laplacian laplacian, double *Q, double *mu, tcb_error *err)
+{
+    if (laplacian == TCB_SOBOLEV_GRAPH) {
+        for (int k = 0; k < r; k++) {
+            double c = sqrt((k ? 2.0 : 1.0) / r);
+            mu[k] = 2.0 - 2.0 * cos(M_PI * k / r);
+            for (int i = 0; i < r; i++) Q[i * r + k] = c * cos(M_PI * k * (i + 0.5) / r);
+        }
+        return TCB_OK;
+    }
+    double *off = malloc((size_t)(r > 1 ? r - 1 : 1) * sizeof *off), *z = malloc((size_t)r * r * sizeof *z),
+           *work = malloc((size_t)(2 * r > 2 ? 2 * r - 2 : 1) * sizeof *work);
+    int info = -1;
+    if (off && z && work) {
+        for (int i = 0; i < r; i++) mu[i] = 2.0 * ((i > 0) + (i < r - 1)); /* twice the neighbours */
+        for (int i = 0; i + 1 < r; i++) off[i] = -1.0;
+        dstev_("V", &r, mu, off, z, &r, work, &info);
+        for (int i = 0; i < r; i++) /* z is column-major: z[k·r + i] is component i of vector k */
+            for (int k = 0; k < r; k++) Q[i * r + k] = z[(size_t)k * r + i];
+    }
+    free(off), free(z), free(work);
+    if (!off || !z || !work) return tcb_fail(err, TCB_ERR_NOMEM, "Sobolev preconditioner: out of memory");
+    if (info) return tcb_fail(err, TCB_ERR_NUMERIC, "Sobolev preconditioner: LAPACK dstev failed (info %d, r = %d)", info, r);
+    return TCB_OK;
+}
+
+int tcb_sobolev_init(tcb_sobolev *s, int r, double lambda, tcb_sobolev_laplacian laplacian, tcb_error *err)
 {
     memset(s, 0, sizeof *s);
-    if (r < 1 || r > 1024 || !(lambda >= 0.0))
+    if (r < 1 || r > 1024 || !(lambda >= 0.0) ||
+        (laplacian != TCB_SOBOLEV_PCGRID && laplacian != TCB_SOBOLEV_GRAPH))
         return tcb_fail(err, TCB_ERR_INPUT, "Sobolev preconditioner: r = %d, lambda = %g", r, lambda);
     size_t n3 = (size_t)r * r * r;
     s->r = r;
     s->lambda = lambda;
+    s->laplacian = laplacian;
     s->Q = malloc((size_t)r * r * sizeof *s->Q);
     s->gain = malloc(n3 * sizeof *s->gain);
     double *mu = malloc((size_t)r * sizeof *mu);
-    if (!s->Q || !s->gain || !mu) {
-        free(mu);
-        tcb_sobolev_free(s);
-        return tcb_fail(err, TCB_ERR_NOMEM, "Sobolev preconditioner: out of memory");
-    }
-    for (int k = 0; k < r; k++) {
-        double c = sqrt((k ? 2.0 : 1.0) / r);
-        mu[k] = 2.0 - 2.0 * cos(M_PI * k / r);
-        for (int i = 0; i < r; i++) s->Q[i * r + k] = c * cos(M_PI * k * (i + 0.5) / r);
-    }
-    for (int z = 0; z < r; z++)
-        for (int y = 0; y < r; y++)
-            for (int x = 0; x < r; x++)
-                s->gain[((size_t)z * r + y) * r + x] = 1.0 / (1.0 + lambda * (mu[x] + mu[y] + mu[z]));
+    int rc = !s->Q || !s->gain || !mu ? tcb_fail(err, TCB_ERR_NOMEM, "Sobolev preconditioner: out of memory")
+                                      : path_eigen(r, laplacian, s->Q, mu, err);
+    if (!rc)
+        for (int z = 0; z < r; z++)
+            for (int y = 0; y < r; y++)
+                for (int x = 0; x < r; x++)
+                    s->gain[((size_t)z * r + y) * r + x] = 1.0 / (1.0 + lambda * (mu[x] + mu[y] + mu[z]));
     free(mu);
-    return TCB_OK;
+    if (rc) tcb_sobolev_free(s);
+    return rc;
 }
 
 void tcb_sobolev_free(tcb_sobolev *s)
@@ -80,6 +110,7 @@ void tcb_sobolev_solve(const tcb_sobolev *s, int F, const float *u, float *v, do
 void tcb_sobolev_apply(const tcb_sobolev *s, int F, const float *v, float *u)
 {
     int r = s->r;
+    double per_neighbour = s->laplacian == TCB_SOBOLEV_PCGRID ? 2.0 : 1.0;
     for (int z = 0; z < r; z++)
         for (int y = 0; y < r; y++)
             for (int x = 0; x < r; x++) {
@@ -87,10 +118,11 @@ void tcb_sobolev_apply(const tcb_sobolev *s, int F, const float *v, float *u)
                 const int c[3] = {x, y, z};
                 const size_t stride[3] = {1, (size_t)r, (size_t)r * r};
                 for (int f = 0; f < F; f++) {
-                    double own = v[node * (size_t)F + (size_t)f], acc = own;
+                    /* each neighbour adds (1 or 2)·own − its value */
+                    double own = v[node * (size_t)F + (size_t)f], acc = own, diag = own * per_neighbour;
                     for (int a = 0; a < 3; a++) {
-                        if (c[a] > 0) acc += s->lambda * (own - v[(node - stride[a]) * (size_t)F + (size_t)f]);
-                        if (c[a] < r - 1) acc += s->lambda * (own - v[(node + stride[a]) * (size_t)F + (size_t)f]);
+                        if (c[a] > 0) acc += s->lambda * (diag - v[(node - stride[a]) * (size_t)F + (size_t)f]);
+                        if (c[a] < r - 1) acc += s->lambda * (diag - v[(node + stride[a]) * (size_t)F + (size_t)f]);
                     }
                     u[node * (size_t)F + (size_t)f] = (float)acc;
                 }

@@ -13,7 +13,7 @@
 
 tcb_neupig_arch tcb_neupig_arch_reference(void)
 {
-    return (tcb_neupig_arch){8, 2, 3, 30, 4, 2, 4, 512, 0.4, 1.5, 0.4, 100.0, 0.3};
+    return (tcb_neupig_arch){8, 2, 3, 30, 4, 2, 4, 512, 0.4, 1.5, 0.4, 100.0, 0.3, TCB_SOBOLEV_PCGRID};
 }
 
 static int mlp_in(const tcb_neupig_arch *a)
@@ -44,7 +44,7 @@ int tcb_neupig_model_init(tcb_neupig_model *m, const tcb_neupig_arch *a, tcb_err
         double lambda = normal ? a->normal_lambda : a->lambda * pow(a->lambda_growth, g);
         size_t r = (size_t)m->res[g];
         m->grid_off[g + 1] = m->grid_off[g] + r * r * r * (size_t)m->width[g];
-        int rc = tcb_sobolev_init(&m->sobolev[g], m->res[g], lambda, err);
+        int rc = tcb_sobolev_init(&m->sobolev[g], m->res[g], lambda, a->laplacian, err);
         if (rc) {
             tcb_neupig_model_free(m);
             return rc;

@@ -45,6 +45,7 @@ typedef struct tcb_neupig_arch {
     double lambda, lambda_growth, normal_lambda; /* 0.4, 1.5, 0.4 */
     double edge_weight;                         /* 100 */
     double welsch_alpha;                        /* 0.3 */
+    tcb_sobolev_laplacian laplacian;            /* the grids' Laplacian: pcgrid's 2D − A */
 } tcb_neupig_arch;
 
 /* The reference's architecture and loss weights (fit_.json). */

@@ -49,7 +49,7 @@
 #include "tcb/meshing.h"
 
 #define CKPT_NAME "train.ckpt"
-#define MAGIC "TCBNPIG1"
+#define MAGIC "TCBNPIG2"
 
 typedef struct neupig_preset {
     long long epochs;
@@ -96,15 +96,16 @@ static int parse(const char *params_json, void *obj, tcb_error *err)
     neupig_method *m = obj;
     static const char *const keys[] = {"preset", "normals", "epochs", "points", "template_faces", "poisson_depth",
                                        "levels", "features", "hidden", "recon_points", "checkpoint_every",
-                                       "divergence", NULL};
+                                       "divergence", "laplacian", NULL};
     const char *where = "neupig.params";
     cJSON *j;
     int rc = tcb_params_parse(params_json, where, keys, &j, err);
     if (rc) return rc;
-    int pi = 2, ni = NORMALS_INPUT;
+    int pi = 2, ni = NORMALS_INPUT, li = TCB_SOBOLEV_PCGRID;
     long long epochs, points, faces, depth, levels, features, hidden, recon;
     rc = tcb_json_enum(j, "preset", where, 0, 2, preset_names, &pi, err);
     if (!rc) rc = tcb_json_enum(j, "normals", where, 0, NORMALS_INPUT, normals_names, &ni, err);
+    if (!rc) rc = tcb_json_enum(j, "laplacian", where, 0, TCB_SOBOLEV_PCGRID, tcb_sobolev_laplacian_names, &li, err);
     const neupig_preset *p = &presets[pi];
     if (!rc) rc = tcb_json_int(j, "epochs", where, 0, p->epochs, 1, 100000000, &epochs, err);
     if (!rc) rc = tcb_json_int(j, "points", where, 0, p->points, 4, 10000000, &points, err);
@@ -121,6 +122,7 @@ static int parse(const char *params_json, void *obj, tcb_error *err)
     if (rc) return rc;
     m->arch = tcb_neupig_arch_reference();
     m->arch.levels = (int)levels, m->arch.features = (int)features, m->arch.hidden = (int)hidden;
+    m->arch.laplacian = (tcb_sobolev_laplacian)li;
     m->sched.epochs = epochs, m->sched.lr_grid = 0.005, m->sched.lr_growth = 2.5, m->sched.lr_mlp = 1e-3;
     m->points = (int)points, m->template_faces = (int)faces, m->poisson_depth = (int)depth;
     m->normals = ni, m->recon_points = (int)recon;
@@ -393,6 +395,7 @@ static cJSON *manifest(const neupig_method *m, size_t n_params)
     const char *const names[] = {"levels", "base_res", "res_step", "features", "normal_res", "normal_features",
                                  "time_freqs", "hidden", "points", "template_faces", "poisson_depth", "gt_normals"};
     for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) cJSON_AddNumberToObject(j, names[k], sizes[k]);
+    cJSON_AddStringToObject(j, "laplacian", tcb_sobolev_laplacian_names[a->laplacian]);
     cJSON_AddNumberToObject(j, "parameters", (double)n_params);
     return j;
 }

@@ -66,7 +66,7 @@ int tcb_neupig_train_step(tcb_neupig_trainer *t, double *loss, tcb_error *err)
 
 static const char *const int_names[] = {"levels", "base_res", "res_step", "features", "normal_res",
                                         "normal_features", "time_freqs", "hidden", "epochs",
-                                        "frames", "template vertices", "keyframe"};
+                                        "frames", "template vertices", "keyframe", "laplacian"};
 static const char *const real_names[] = {"lambda", "lambda_growth", "normal_lambda", "edge_weight",
                                          "welsch_alpha", "lr_grid", "lr_growth", "lr_mlp"};
 
@@ -77,10 +77,11 @@ static tcb_ckpt_spec spec_of(tcb_neupig_trainer *t, uint64_t seed)
     const tcb_neupig_schedule *s = &t->sched;
     size_t n = t->model.n_params;
     return (tcb_ckpt_spec){
-        .magic = "TCBNPIG1", .what = "a Neu-PiG training checkpoint",
-        .n_ints = 12, .n_reals = 8, .n_arrays = 3, .int_names = int_names, .real_names = real_names,
+        .magic = "TCBNPIG2", .what = "a Neu-PiG training checkpoint",
+        .n_ints = 13, .n_reals = 8, .n_arrays = 3, .int_names = int_names, .real_names = real_names,
         .ints = {a->levels, a->base_res, a->res_step, a->features, a->normal_res, a->normal_features,
-                 a->time_freqs, a->hidden, s->epochs, t->problem->T, t->problem->nv, t->problem->key},
+                 a->time_freqs, a->hidden, s->epochs, t->problem->T, t->problem->nv, t->problem->key,
+                 a->laplacian},
         .reals = {a->lambda, a->lambda_growth, a->normal_lambda, a->edge_weight, a->welsch_alpha,
                   s->lr_grid, s->lr_growth, s->lr_mlp},
         .seed = seed, .max_it = s->epochs,

@@ -3,7 +3,7 @@ neupig_torch.py, written from the method's description), on a small
 random problem, against methods/neupig/model.c (tests/pytorch/neupig_step.c).
 
 The grids' preconditioned parameters u give the values v = M^-1 u, solved
-densely here (small grids); everything in float64. The DCT solve and the
+densely here (small grids); everything in float64. The eigenbasis solve and the
 GEMM-form nearest neighbours the bench's peer uses are checked against the
 dense solve and the brute-force search on the same problem.
 Passes when the loss and each parameter block's gradient agree with the C
@@ -108,10 +108,10 @@ with torch.no_grad():
 err = abs(gemm.item() - total.item()) / abs(total.item())
 print(f"loss with the GEMM-form search: {err:.1e} from the brute-force one")
 assert err <= 1e-12, f"the GEMM-form nearest neighbours change the loss by {err:.1e}"
-for g, (dense, dct) in enumerate(zip(nt.solvers(arch, nt.dense_solver), nt.solvers(arch, nt.dct_solver))):
+for g, (dense, basis) in enumerate(zip(nt.solvers(arch, nt.dense_solver), nt.solvers(arch, nt.basis_solver))):
     u = grids[g].detach().reshape(-1, nt.widths(arch)[g])
-    err = (torch.max(torch.abs(dct(u) - dense(u))) / torch.max(torch.abs(dense(u)))).item()
-    print(f"grid {g}: the DCT solve against the dense one: {err:.1e} of the largest value")
-    assert err <= 1e-12, f"grid {g}: the DCT solve differs from the dense one by {err:.1e}"
+    err = (torch.max(torch.abs(basis(u) - dense(u))) / torch.max(torch.abs(dense(u)))).item()
+    print(f"grid {g}: the eigenbasis solve against the dense one: {err:.1e} of the largest value")
+    assert err <= 1e-12, f"grid {g}: the eigenbasis solve differs from the dense one by {err:.1e}"
 assert worst <= 1e-4, f"Neu-PiG step differs from the PyTorch reference by {worst:.2e} (> 1e-4)"
 print(f"OK: loss and every gradient within {worst:.2e} of PyTorch")

@@ -4,7 +4,7 @@ src/utilities/loss_f.py, src/loss_time_smoothing.py, src/rotation.py,
 src/network/*; grids from vc-bonn/pcgrid src/pcgrid/grid.py): the
 reference of tests/pytorch/neupig_step_check.py (float64, small grids
 solved densely) and of bench/train_step_neupig_torch.py (float32, the
-paper's and the cpu preset's sizes, the solve in the DCT basis).
+paper's and the cpu preset's sizes, the solve in the eigenbasis).
 
 Every operation is the reference's: grid_sample with align_corners=True
 and border padding, levels averaged then tanh, the Fourier time features,
@@ -12,10 +12,11 @@ Linear + LeakyReLU(0.01), the quaternion rotation as PyTorch3D's
 quaternion_to_matrix, translation tanh(0.1 d), the Welsch-weighted two-way
 Chamfer (sums of squared nearest distances, weights detached), the pdg
 confidence, 100 x the edge-length L1. Only the grids' solve v = M^-1 u,
-M = I + lambda L, is passed in: `dense_solver` (torch.linalg.solve, small
-grids) or `dct_solver` (exact in the DCT-II basis, as tcbench's
-neural/sobolev.c; the reference's conjugate gradient reaches the same v
-to its tolerance: docs/protocol.md, "Neu-PiG").
+M = I + lambda L with L as pcgrid builds it (2D - A: `laplacian`), is
+passed in: `dense_solver` (torch.linalg.solve, small grids) or
+`basis_solver` (exact in the eigenbasis of the three path matrices, as
+tcbench's neural/sobolev.c; the reference's conjugate gradient reaches the
+same v to its tolerance: docs/protocol.md, "Neu-PiG").
 """
 import math
 from collections import namedtuple
@@ -48,20 +49,24 @@ def mlp_shapes(a):
 
 
 def laplacian(r):
-    """The 6-neighbour lattice Laplacian of r^3 nodes, x fastest."""
-    n = r ** 3
-    L = np.zeros((n, n))
+    """The 6-neighbour lattice Laplacian of r^3 nodes, x fastest, as pcgrid
+    builds it: -1 per directed edge of a list holding both directions of
+    every edge, and on the diagonal each node's count of occurrences in
+    that list, both columns together (so twice its neighbours: 2D - A)."""
+    edges = []
     for z in range(r):
         for y in range(r):
             for x in range(r):
-                i = (z * r + y) * r + x
-                for dz, dy, dx in ((1, 0, 0), (0, 1, 0), (0, 0, 1)):
+                for dz, dy, dx in ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)):
                     zz, yy, xx = z + dz, y + dy, x + dx
-                    if zz < r and yy < r and xx < r:
-                        j = (zz * r + yy) * r + xx
-                        L[i, j] = L[j, i] = -1
-                        L[i, i] += 1
-                        L[j, j] += 1
+                    if 0 <= zz < r and 0 <= yy < r and 0 <= xx < r:
+                        edges.append(((z * r + y) * r + x, (zz * r + yy) * r + xx))
+    L = np.zeros((r ** 3, r ** 3))
+    if edges:
+        e = np.array(edges).T
+        L[e[0], e[1]] = -1
+        nodes, counts = np.unique(e, return_counts=True)
+        L[nodes, nodes] = counts
     return torch.tensor(L, dtype=torch.get_default_dtype())
 
 
@@ -70,14 +75,17 @@ def dense_solver(r, lam):
     return lambda u: torch.linalg.solve(M, u)
 
 
-def dct_solver(r, lam):
+def basis_solver(r, lam):
     """v = (I + lam L)^-1 u exactly: L is the Kronecker sum of three path
-    Laplacians, whose eigenvectors are the orthonormal DCT-II's rows and
-    eigenvalues 2 - 2 cos(pi k / r)."""
-    k = torch.arange(r, dtype=torch.float64)
-    C = torch.cos(math.pi * (k[None] + 0.5) * k[:, None] / r) * math.sqrt(2.0 / r)
-    C[0] /= math.sqrt(2.0)
-    e = 2 - 2 * torch.cos(math.pi * k / r)
+    matrices P (tridiagonal: -1 off the diagonal, twice the neighbour count
+    on it), so M^-1 is diagonal in the basis of P's eigenvectors."""
+    P = torch.zeros((r, r), dtype=torch.float64)
+    for i in range(r):
+        P[i, i] = 2.0 * ((i > 0) + (i < r - 1))
+        if i + 1 < r:
+            P[i, i + 1] = P[i + 1, i] = -1.0
+    e, Q = torch.linalg.eigh(P)
+    C = Q.T  # rows: eigenvectors
     scale = 1 / (1 + lam * (e[:, None, None] + e[None, :, None] + e[None, None, :]))
     dt = torch.get_default_dtype()
     C, scale = C.to(dt), scale.to(dt)

@@ -1,8 +1,11 @@
-/* neural/sobolev.c: the exact DCT solve of (I + λL) v = u on a lattice,
+/* neural/sobolev.c: the exact solve of (I + λL) v = u on a lattice,
  * checked against conjugate gradient on the sparse matrix written here
  * (run to convergence, and as the reference stops it: ≤ 100 iterations,
  * ‖r‖² < 1e-4), against its own sparse apply, and as the gradient of the
- * parameterisation by central differences of ℓ(u) = Σ a·M⁻¹u in double. */
+ * parameterisation by central differences of ℓ(u) = Σ a·M⁻¹u in double;
+ * for both Laplacians: the graph one (D − A, the DCT's) and pcgrid's, whose
+ * diagonal is counted here as pcgrid counts it (each node's occurrences in
+ * an edge list holding both directions of every edge). */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -20,6 +23,45 @@
 enum { R = 6, F = 2, NV = R * R * R * F };
 #define LAMBDA 0.9
 
+static tcb_sobolev_laplacian kind;
+static double diag[R * R * R]; /* L's diagonal */
+
+/* The diagonal as each Laplacian defines it: the graph's counts a node's
+ * neighbours; pcgrid's counts the node's occurrences in the list of
+ * directed edges (node, neighbour) over all nodes, both columns. */
+static void count_diagonal(void)
+{
+    for (int i = 0; i < R * R * R; i++) diag[i] = 0;
+    for (int z = 0; z < R; z++)
+        for (int y = 0; y < R; y++)
+            for (int x = 0; x < R; x++)
+                for (int a = 0; a < 3; a++)
+                    for (int s = -1; s <= 1; s += 2) {
+                        int c[3] = {x, y, z};
+                        c[a] += s;
+                        if (c[a] < 0 || c[a] >= R) continue;
+                        int from = (z * R + y) * R + x, to = (c[2] * R + c[1]) * R + c[0];
+                        diag[from] += 1;                         /* the edge's first column */
+                        if (kind == TCB_SOBOLEV_PCGRID) diag[to] += 1; /* and its second */
+                    }
+}
+
+static int setup_pcgrid(void **state)
+{
+    (void)state;
+    kind = TCB_SOBOLEV_PCGRID;
+    count_diagonal();
+    return 0;
+}
+
+static int setup_graph(void **state)
+{
+    (void)state;
+    kind = TCB_SOBOLEV_GRAPH;
+    count_diagonal();
+    return 0;
+}
+
 /* y = M x in double, the lattice's 6-neighbour Laplacian written out. */
 static void ref_apply(const double *x, double *y)
 {
@@ -29,14 +71,14 @@ static void ref_apply(const double *x, double *y)
                 for (int f = 0; f < F; f++) {
                     int c[3] = {xx, yy, z};
                     size_t node = ((size_t)z * R + yy) * R + xx, i = node * F + f;
-                    double acc = x[i];
+                    double acc = x[i] + LAMBDA * diag[node] * x[i];
                     for (int a = 0; a < 3; a++)
                         for (int s = -1; s <= 1; s += 2) {
                             int cc[3] = {c[0], c[1], c[2]};
                             cc[a] += s;
                             if (cc[a] < 0 || cc[a] >= R) continue;
                             size_t nb = ((size_t)cc[2] * R + cc[1]) * R + cc[0];
-                            acc += LAMBDA * (x[i] - x[nb * F + f]);
+                            acc -= LAMBDA * x[nb * F + f];
                         }
                     y[i] = acc;
                 }
@@ -73,7 +115,7 @@ static tcb_sobolev make(void)
 {
     tcb_sobolev s;
     tcb_error err = {0};
-    assert_int_equal(tcb_sobolev_init(&s, R, LAMBDA, &err), TCB_OK);
+    assert_int_equal(tcb_sobolev_init(&s, R, LAMBDA, kind, &err), TCB_OK);
     return s;
 }
 
@@ -99,8 +141,8 @@ static void test_solve_matches_cg(void **state)
     /* Exact to float rounding; the reference's stopping rule leaves more. */
     assert_true(worst <= 1e-6 * scale);
     assert_true(worst_ref <= 5e-3 * scale); /* the two agree to the reference's tolerance */
-    printf("DCT solve vs converged CG: %.2e; the reference's CG (<= 100 it, |r|^2 < 1e-4) vs "
-           "converged: %.2e (max |v| %.3f)\n", worst, worst_ref, scale);
+    printf("%s: exact solve vs converged CG: %.2e; the reference's CG (<= 100 it, |r|^2 < 1e-4) vs "
+           "converged: %.2e (max |v| %.3f)\n", tcb_sobolev_laplacian_names[kind], worst, worst_ref, scale);
     free(ud);
     tcb_sobolev_free(&s);
 }
@@ -160,16 +202,16 @@ static void test_single_node_and_bad_input(void **state)
     (void)state;
     tcb_sobolev s;
     tcb_error err = {0};
-    assert_int_equal(tcb_sobolev_init(&s, 1, 0.4, &err), TCB_OK);
+    assert_int_equal(tcb_sobolev_init(&s, 1, 0.4, kind, &err), TCB_OK);
     float u[2] = {0.25f, -3.0f}, v[2];
     double scratch[2];
     tcb_sobolev_solve(&s, 2, u, v, scratch);
     assert_near(v[0], 0.25, 1e-7); /* one node: L = 0, M = I */
     assert_near(v[1], -3.0, 1e-6);
     tcb_sobolev_free(&s);
-    assert_int_equal(tcb_sobolev_init(&s, 0, 0.4, &err), TCB_ERR_INPUT);
-    assert_int_equal(tcb_sobolev_init(&s, 4, -1.0, &err), TCB_ERR_INPUT);
-    assert_int_equal(tcb_sobolev_init(&s, 4, NAN, &err), TCB_ERR_INPUT);
+    assert_int_equal(tcb_sobolev_init(&s, 0, 0.4, kind, &err), TCB_ERR_INPUT);
+    assert_int_equal(tcb_sobolev_init(&s, 4, -1.0, kind, &err), TCB_ERR_INPUT);
+    assert_int_equal(tcb_sobolev_init(&s, 4, NAN, kind, &err), TCB_ERR_INPUT);
 }
 
 int main(void)
@@ -177,5 +219,6 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_solve_matches_cg), cmocka_unit_test(test_apply_then_solve),
         cmocka_unit_test(test_gradient), cmocka_unit_test(test_single_node_and_bad_input)};
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    int failed = cmocka_run_group_tests_name("pcgrid's 2D - A", tests, setup_pcgrid, NULL);
+    return failed + cmocka_run_group_tests_name("graph D - A", tests, setup_graph, NULL);
 }
