@@ -1,8 +1,9 @@
 /* neural/lattice.c against a double-precision reference written here from
  * PyTorch's grid_sample(align_corners=True, padding_mode="border") rules:
  * values at the nodes, linear functions reproduced exactly, the border
- * clamp, and the backward checked by central differences of the
- * reference objective ℓ = Σ a·out (and as the forward's adjoint). */
+ * clamp, one node, and the backwards (in the values and in the points)
+ * checked by central differences of the reference objective ℓ = Σ a·out
+ * (and the values' as the forward's adjoint). */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -21,12 +22,12 @@
 /* The reference sample of one point, in double, from the rules: u = (p+1)/2·(r−1)
  * clamped to [0, r−1]; the corners floor(u), floor(u)+1, a corner past the
  * last node weighing nothing. */
-static void ref_sample(const double *values, int r, int F, const float p[3], double *out)
+static void ref_sample_at(const double *values, int r, int F, const double p[3], double *out)
 {
     double u[3];
     int i0[3];
     for (int a = 0; a < 3; a++) {
-        u[a] = fmin(fmax(((double)p[a] + 1.0) * 0.5 * (r - 1), 0.0), r - 1.0);
+        u[a] = fmin(fmax((p[a] + 1.0) * 0.5 * (r - 1), 0.0), r - 1.0);
         i0[a] = (int)floor(u[a]);
     }
     for (int f = 0; f < F; f++) out[f] = 0.0;
@@ -38,6 +39,12 @@ static void ref_sample(const double *values, int r, int F, const float p[3], dou
         const double *v = values + ((size_t)(idx[2] * r + idx[1]) * r + idx[0]) * F;
         for (int f = 0; f < F; f++) out[f] += w * v[f];
     }
+}
+
+static void ref_sample(const double *values, int r, int F, const float p[3], double *out)
+{
+    const double pd[3] = {p[0], p[1], p[2]};
+    ref_sample_at(values, r, F, pd, out);
 }
 
 static double ref_objective(const double *values, int r, int F, const float *pts, int n,
@@ -125,10 +132,62 @@ static void test_backward(void **state)
     free(ad);
 }
 
+/* The points' gradient against central differences of the reference in
+ * the points, at points inside cells (off the cell walls, where the
+ * sample has a kink) and outside the cube on some axes (zero there). */
+static void test_backward_points(void **state)
+{
+    (void)state;
+    tcb_rng rng;
+    tcb_rng_seed_stream(&rng, 3, "lattice");
+    float values[R * R * R * F], pts[3 * N], dout[N * F], dpts[3 * N] = {0};
+    tu_fill_uniform(&rng, values, (size_t)R * R * R * F, -1.0, 1.0);
+    for (int p = 0; p < N; p++)
+        for (int a = 0; a < 3; a++) {
+            /* a cell's middle part, or beyond the cube for every fifth point's y */
+            int c = (int)(tcb_rng_uniform(&rng) * (R - 1));
+            double off = 0.1 + 0.8 * tcb_rng_uniform(&rng);
+            pts[3 * p + a] = (float)(-1.0 + 2.0 * (c + off) / (R - 1));
+            if (a == 1 && p % 5 == 0) pts[3 * p + a] = p % 10 ? 1.2f : -1.4f;
+        }
+    tu_fill_uniform(&rng, dout, N * F, -1.0, 1.0);
+    tcb_lattice_backward_points(dpts, dout, values, R, F, pts, N, 0.5f);
+    double *vd = tu_to_double(values, R * R * R * F), out_p[F], out_m[F];
+    for (int p = 0; p < N; p++)
+        for (int a = 0; a < 3; a++) {
+            double q[3] = {pts[3 * p], pts[3 * p + 1], pts[3 * p + 2]};
+            q[a] += FD_H;
+            ref_sample_at(vd, R, F, q, out_p);
+            q[a] -= 2 * FD_H;
+            ref_sample_at(vd, R, F, q, out_m);
+            double fd = 0.0;
+            for (int f = 0; f < F; f++) fd += dout[p * F + f] * (out_p[f] - out_m[f]) / (2 * FD_H);
+            assert_near(dpts[3 * p + a], 0.5 * fd, 1e-4);
+            if (a == 1 && p % 5 == 0) assert_true(dpts[3 * p + a] == 0.0f);
+        }
+    free(vd);
+}
+
+/* One node: its value everywhere, no gradient to the points. */
+static void test_single_node(void **state)
+{
+    (void)state;
+    float value[2] = {0.25f, -1.5f}, pts[6] = {0.3f, -0.9f, 2.0f, -1.0f, 1.0f, 0.0f}, out[4] = {0}, dv[2] = {0};
+    float dout[4] = {1.0f, 2.0f, -1.0f, 0.5f}, dpts[6] = {0};
+    tcb_lattice_forward(out, value, 1, 2, pts, 2, 1.0f);
+    for (int p = 0; p < 2; p++) assert_true(out[2 * p] == 0.25f && out[2 * p + 1] == -1.5f);
+    tcb_lattice_backward(dv, dout, 1, 2, pts, 2, 1.0f);
+    assert_true(dv[0] == 0.0f && dv[1] == 2.5f);
+    tcb_lattice_backward_points(dpts, dout, value, 1, 2, pts, 2, 1.0f);
+    for (int k = 0; k < 6; k++) assert_true(dpts[k] == 0.0f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_forward_matches_reference),
                                        cmocka_unit_test(test_linear_exact),
-                                       cmocka_unit_test(test_backward)};
+                                       cmocka_unit_test(test_backward),
+                                       cmocka_unit_test(test_backward_points),
+                                       cmocka_unit_test(test_single_node)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
