@@ -64,7 +64,7 @@ OWNER = {
     "npy": "core", "npz": "core", "progress": "core", "rng": "core", "geometry": "core",
     "mesh": "core", "sysinfo": "core", "version": "core",
     "metrics": "metrics", "geodesic": "metrics", "bootstrap": "metrics", "wilcoxon": "metrics",
-    "locate": "meshing", "meshing": "meshing", "cholesky": "meshing",
+    "locate": "meshing", "meshing": "meshing", "cholesky": "meshing", "large_steps": "meshing",
     "sequence": "datasets", "split": "datasets", "synth": "datasets", "align": "datasets",
     "block": "datasets", "dfaust": "datasets", "distortion": "datasets", "mesh_io": "datasets",
     "method": "interface", "registry": "interface",
