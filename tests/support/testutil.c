@@ -139,3 +139,22 @@ int tu_for_each_json(const char *dir, void (*fn)(const char *path, void *arg), v
     closedir(d);
     return n;
 }
+
+void tu_ref_trilinear(const double *values, int r, int F, const double p[3], double *out)
+{
+    double u[3];
+    int i0[3];
+    for (int a = 0; a < 3; a++) {
+        u[a] = fmin(fmax((p[a] + 1.0) * 0.5 * (r - 1), 0.0), r - 1.0);
+        i0[a] = (int)floor(u[a]);
+    }
+    for (int f = 0; f < F; f++) out[f] = 0.0;
+    for (int c = 0; c < 8; c++) {
+        int idx[3] = {i0[0] + (c & 1), i0[1] + ((c >> 1) & 1), i0[2] + (c >> 2)};
+        double w = 1.0;
+        for (int a = 0; a < 3; a++) w *= (idx[a] == i0[a]) ? 1.0 - (u[a] - i0[a]) : u[a] - i0[a];
+        if (idx[0] >= r || idx[1] >= r || idx[2] >= r) continue;
+        const double *v = values + ((size_t)(idx[2] * r + idx[1]) * r + idx[0]) * F;
+        for (int f = 0; f < F; f++) out[f] += w * v[f];
+    }
+}

@@ -47,6 +47,14 @@ double *tu_to_double(const float *x, size_t n);
 struct tcb_rng;
 void tu_fill_uniform(struct tcb_rng *r, float *x, size_t n, double lo, double hi);
 
+/* The trilinear sample out [F] of a lattice values [r³][F] (x fastest) at
+ * the point p, in double, written from PyTorch's grid_sample rules
+ * (align_corners=True, padding_mode="border"): u = (p+1)/2·(r−1) clamped
+ * to [0, r−1], the corners floor(u) and floor(u)+1, a corner past the last
+ * node weighing nothing; r = 1 is the one node's value. The reference of
+ * neural/lattice.c's tests and of the methods sampling lattices. */
+void tu_ref_trilinear(const double *values, int r, int F, const double p[3], double *out);
+
 /* 1 when nf triangles form closed surfaces, consistently oriented: every
  * directed edge occurs once and its reverse occurs too (so each undirected
  * edge has exactly two faces, wound opposite ways); 0 otherwise. */

@@ -19,32 +19,10 @@
 
 #define FD_H 1e-6
 
-/* The reference sample of one point, in double, from the rules: u = (p+1)/2·(r−1)
- * clamped to [0, r−1]; the corners floor(u), floor(u)+1, a corner past the
- * last node weighing nothing. */
-static void ref_sample_at(const double *values, int r, int F, const double p[3], double *out)
-{
-    double u[3];
-    int i0[3];
-    for (int a = 0; a < 3; a++) {
-        u[a] = fmin(fmax((p[a] + 1.0) * 0.5 * (r - 1), 0.0), r - 1.0);
-        i0[a] = (int)floor(u[a]);
-    }
-    for (int f = 0; f < F; f++) out[f] = 0.0;
-    for (int c = 0; c < 8; c++) {
-        int idx[3] = {i0[0] + (c & 1), i0[1] + ((c >> 1) & 1), i0[2] + (c >> 2)};
-        double w = 1.0;
-        for (int a = 0; a < 3; a++) w *= (idx[a] == i0[a]) ? 1.0 - (u[a] - i0[a]) : u[a] - i0[a];
-        if (idx[0] >= r || idx[1] >= r || idx[2] >= r) continue;
-        const double *v = values + ((size_t)(idx[2] * r + idx[1]) * r + idx[0]) * F;
-        for (int f = 0; f < F; f++) out[f] += w * v[f];
-    }
-}
-
 static void ref_sample(const double *values, int r, int F, const float p[3], double *out)
 {
     const double pd[3] = {p[0], p[1], p[2]};
-    ref_sample_at(values, r, F, pd, out);
+    tu_ref_trilinear(values, r, F, pd, out);
 }
 
 static double ref_objective(const double *values, int r, int F, const float *pts, int n,
@@ -157,9 +135,9 @@ static void test_backward_points(void **state)
         for (int a = 0; a < 3; a++) {
             double q[3] = {pts[3 * p], pts[3 * p + 1], pts[3 * p + 2]};
             q[a] += FD_H;
-            ref_sample_at(vd, R, F, q, out_p);
+            tu_ref_trilinear(vd, R, F, q, out_p);
             q[a] -= 2 * FD_H;
-            ref_sample_at(vd, R, F, q, out_m);
+            tu_ref_trilinear(vd, R, F, q, out_m);
             double fd = 0.0;
             for (int f = 0; f < F; f++) fd += dout[p * F + f] * (out_p[f] - out_m[f]) / (2 * FD_H);
             assert_near(dpts[3 * p + a], 0.5 * fd, 1e-4);
