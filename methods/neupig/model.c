@@ -10,6 +10,7 @@
 #include "neural/fourier_time.h"
 #include "neural/lattice.h"
 #include "neural/rigid.h"
+#include "neural/robust_chamfer.h"
 
 tcb_neupig_arch tcb_neupig_arch_reference(void)
 {
@@ -186,7 +187,7 @@ static int loss_backward(const tcb_neupig_model *m, const tcb_neupig_problem *p,
     double conf[4096];
     if (p->T > 4096) return tcb_fail(err, TCB_ERR_INPUT, "neupig: %d frames, at most 4096", p->T);
     for (int t = 0; t < p->T; t++) {
-        int rc = tcb_neupig_chamfer(X + t * frame, p->nv, p->points[t], p->n_points[t],
+        int rc = tcb_robust_chamfer(X + t * frame, p->nv, p->points[t], p->n_points[t],
                                     p->points_index[t], m->a.welsch_alpha, &cd[t], dX + t * frame, err);
         if (rc) return rc;
     }
