@@ -36,8 +36,8 @@
 #include <string.h>
 
 #include "methods/builtin.h"
-#include "methods/neupig/prepare.h"
-#include "methods/neupig/template.h"
+#include "methods/pcgrid/prepare.h"
+#include "methods/pcgrid/template.h"
 #include "methods/neupig/train.h"
 #include "methods/params.h"
 #include "methods/step_cost.h"
@@ -84,7 +84,7 @@ typedef struct neupig_method {
     uint64_t seed;
     /* The fitted model (after fit or load). */
     float *params;                 /* [n_params] */
-    tcb_neupig_frame_map map;      /* sequence coordinates → the grids' cube */
+    tcb_pcgrid_frame_map map;      /* sequence coordinates → the grids' cube */
     tcb_mesh template_mesh;        /* in the cube */
     float *deformed;               /* [T][nv][3] the template in every frame, in the cube */
     int n_frames;
@@ -191,9 +191,9 @@ static int draw_clouds(neupig_method *m, const tcb_sequence *seq, uint64_t seed,
             return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
         rc = tcb_sequence_draw_points(seq, t, m->points, seq->draw_with_replacement, &rng, in->clouds[t], err);
     }
-    if (!rc) rc = tcb_neupig_frame_map_of((const float *const *)in->clouds, in->n, in->T, &m->map, err);
+    if (!rc) rc = tcb_pcgrid_frame_map_of((const float *const *)in->clouds, in->n, in->T, &m->map, err);
     for (int t = 0; !rc && t < in->T; t++) {
-        tcb_neupig_map_points(&m->map, in->clouds[t], in->n[t], in->clouds[t]);
+        tcb_pcgrid_map_points(&m->map, in->clouds[t], in->n[t], in->clouds[t]);
         rc = tcb_nn_build(in->clouds[t], in->n[t], &in->index[t], err);
     }
     return rc;
@@ -218,14 +218,15 @@ static int prepare(neupig_method *m, const tcb_sequence *seq, uint64_t seed, inp
     m->gt_normals = uses_gt_normals(m, seq);
     int rc = draw_clouds(m, seq, seed, in, err);
     if (!rc)
-        rc = tcb_neupig_keyframe((const float *const *)in->clouds, in->n, in->T, TCB_NEUPIG_KEYFRAME_RES, &in->key, err);
-    const tcb_neupig_template_spec spec = {m->gt_normals, m->poisson_depth, m->template_faces};
+        rc = tcb_pcgrid_keyframe((const float *const *)in->clouds, in->n, in->T, TCB_PCGRID_KEYFRAME_RES, &in->key, err);
+    const tcb_pcgrid_template_spec spec = {
+        .gt_normals = m->gt_normals, .poisson_depth = m->poisson_depth, .template_faces = m->template_faces};
     if (!rc)
-        rc = tcb_neupig_template_build(seq, in->key, &m->map, in->clouds[in->key], in->n[in->key], &spec,
+        rc = tcb_pcgrid_template_build(seq, in->key, &m->map, in->clouds[in->key], in->n[in->key], &spec,
                                        &m->template_mesh, err);
     const tcb_mesh *t = &m->template_mesh;
-    if (!rc) rc = tcb_neupig_template_normals(t, &in->vnormals, err);
-    if (!rc) rc = tcb_neupig_template_edges(t, &in->edges, &in->edge_len, &in->ne, err);
+    if (!rc) rc = tcb_pcgrid_template_normals(t, &in->vnormals, err);
+    if (!rc) rc = tcb_pcgrid_template_edges(t, &in->edges, &in->edge_len, &in->ne, err);
     if (!rc)
         in->problem = (tcb_neupig_problem){t->n_verts, t->verts, in->vnormals, in->ne, in->edges, in->edge_len,
                                            in->T, (const float *const *)in->clouds, in->n,
@@ -279,7 +280,7 @@ static int fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_
     inputs in;
     fit_state s = {.seed = ctx->seed};
     int rc = prepare(m, seq, ctx->seed, &in, err);
-    if (!rc) rc = tcb_neupig_template_write(&m->template_mesh, &m->map, ctx->work_dir, in.key, err);
+    if (!rc) rc = tcb_pcgrid_template_write(&m->template_mesh, &m->map, ctx->work_dir, in.key, err);
     if (!rc) rc = tcb_neupig_trainer_init(&s.trainer, &m->arch, &m->sched, &in.problem, ctx->seed, err);
     if (!rc) {
         tcb_train_loop loop = {.name = "neupig", .iterations = m->sched.epochs, .checkpoint_every = m->checkpoint_every,
@@ -327,11 +328,11 @@ static int transfer(void *self, const tcb_sequence *seq, int i, int j, const flo
     const tcb_mesh *t = &m->template_mesh;
     tcb_surface_point *loc = malloc((size_t)n * sizeof *loc);
     if (!loc) return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
-    tcb_neupig_map_points(&m->map, src, n, out);
+    tcb_pcgrid_map_points(&m->map, src, n, out);
     rc = tcb_mesh_locate(frame_of(m, i), t->n_verts, t->faces, t->n_faces, out, n, loc, NULL, err);
     if (!rc) {
         tcb_surface_points(frame_of(m, j), t->faces, loc, n, out);
-        tcb_neupig_unmap_points(&m->map, out, n);
+        tcb_pcgrid_unmap_points(&m->map, out, n);
     }
     free(loc);
     return rc;
@@ -353,7 +354,7 @@ static int reconstruct(void *self, const tcb_sequence *seq, int i, int j, int fr
         free(*pts), *pts = NULL;
         return rc;
     }
-    tcb_neupig_unmap_points(&m->map, *pts, m->recon_points);
+    tcb_pcgrid_unmap_points(&m->map, *pts, m->recon_points);
     *n = m->recon_points;
     return TCB_OK;
 }
@@ -377,7 +378,7 @@ static int surface(void *self, const tcb_sequence *seq, int frame, tcb_rng *rng,
         return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
     }
     memcpy(out->verts, frame_of(m, frame), vbytes);
-    tcb_neupig_unmap_points(&m->map, out->verts, t->n_verts);
+    tcb_pcgrid_unmap_points(&m->map, out->verts, t->n_verts);
     memcpy(out->faces, t->faces, fbytes);
     out->n_verts = t->n_verts, out->n_faces = t->n_faces;
     return TCB_OK;

@@ -1,11 +1,11 @@
-/* Neu-PiG's normalisation and keyframe (methods/neupig/prepare.h). */
-#include "methods/neupig/prepare.h"
+/* The pcgrid methods' normalisation and keyframe (methods/pcgrid/prepare.h). */
+#include "methods/pcgrid/prepare.h"
 
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 
-int tcb_neupig_frame_map_of(const float *const *points, const int *n, int T, tcb_neupig_frame_map *out,
+int tcb_pcgrid_frame_map_of(const float *const *points, const int *n, int T, tcb_pcgrid_frame_map *out,
                             tcb_error *err)
 {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -15,23 +15,23 @@ int tcb_neupig_frame_map_of(const float *const *points, const int *n, int T, tcb
             for (int k = 0; k < 3; k++) {
                 double x = points[t][3 * (size_t)i + k];
                 if (!isfinite(x))
-                    return tcb_fail(err, TCB_ERR_NUMERIC, "neupig: frame %d, point %d is not finite", t, i);
+                    return tcb_fail(err, TCB_ERR_NUMERIC, "input clouds: frame %d, point %d is not finite", t, i);
                 lo[k] = fmin(lo[k], x), hi[k] = fmax(hi[k], x);
             }
-    if (!total) return tcb_fail(err, TCB_ERR_INPUT, "neupig: no input points");
+    if (!total) return tcb_fail(err, TCB_ERR_INPUT, "input clouds: no point");
     double half = 0.0;
     for (int k = 0; k < 3; k++) out->centre[k] = 0.5 * (hi[k] + lo[k]), half = fmax(half, 0.5 * (hi[k] - lo[k]));
-    if (!(half > 0.0)) return tcb_fail(err, TCB_ERR_INPUT, "neupig: every input point is the same");
-    out->scale = TCB_NEUPIG_MARGIN / half;
+    if (!(half > 0.0)) return tcb_fail(err, TCB_ERR_INPUT, "input clouds: every point is the same");
+    out->scale = TCB_PCGRID_MARGIN / half;
     return TCB_OK;
 }
 
-void tcb_neupig_map_points(const tcb_neupig_frame_map *m, const float *pts, int n, float *out)
+void tcb_pcgrid_map_points(const tcb_pcgrid_frame_map *m, const float *pts, int n, float *out)
 {
     for (size_t i = 0; i < 3 * (size_t)n; i++) out[i] = (float)((pts[i] - m->centre[i % 3]) * m->scale);
 }
 
-void tcb_neupig_unmap_points(const tcb_neupig_frame_map *m, float *pts, int n)
+void tcb_pcgrid_unmap_points(const tcb_pcgrid_frame_map *m, float *pts, int n)
 {
     for (size_t i = 0; i < 3 * (size_t)n; i++) pts[i] = (float)(pts[i] / m->scale + m->centre[i % 3]);
 }
@@ -60,12 +60,12 @@ static int occupied(const float *pts, int n, int res, uint64_t *keys)
     return count;
 }
 
-int tcb_neupig_keyframe(const float *const *points, const int *n, int T, int res, int *key, tcb_error *err)
+int tcb_pcgrid_keyframe(const float *const *points, const int *n, int T, int res, int *key, tcb_error *err)
 {
     int most = 0;
     for (int t = 0; t < T; t++) most = n[t] > most ? n[t] : most;
     uint64_t *keys = malloc((size_t)(most > 0 ? most : 1) * sizeof *keys);
-    if (!keys) return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory for the keyframe");
+    if (!keys) return tcb_fail(err, TCB_ERR_NOMEM, "keyframe: out of memory");
     double best = -1.0;
     int first = -((T + 1) / 2); /* ⌊−T/2⌋ */
     for (int t = 0; t < T; t++) {
