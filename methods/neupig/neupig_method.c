@@ -36,7 +36,7 @@
 #include <string.h>
 
 #include "methods/builtin.h"
-#include "methods/pcgrid/prepare.h"
+#include "methods/pcgrid/fitted.h"
 #include "methods/pcgrid/template.h"
 #include "methods/neupig/train.h"
 #include "methods/params.h"
@@ -84,10 +84,7 @@ typedef struct neupig_method {
     uint64_t seed;
     /* The fitted model (after fit or load). */
     float *params;                 /* [n_params] */
-    tcb_pcgrid_frame_map map;      /* sequence coordinates → the grids' cube */
-    tcb_mesh template_mesh;        /* in the cube */
-    float *deformed;               /* [T][nv][3] the template in every frame, in the cube */
-    int n_frames;
+    tcb_pcgrid_fitted fitted;      /* the cube's map, the template and its frames */
     struct steps *steps;           /* train_steps' training; NULL: none */
 } neupig_method;
 
@@ -123,6 +120,7 @@ static int parse(const char *params_json, void *obj, tcb_error *err)
     m->arch = tcb_neupig_arch_reference();
     m->arch.levels = (int)levels, m->arch.features = (int)features, m->arch.hidden = (int)hidden;
     m->arch.laplacian = (tcb_sobolev_laplacian)li;
+    m->fitted.method = "neupig";
     m->sched.epochs = epochs, m->sched.lr_grid = 0.005, m->sched.lr_growth = 2.5, m->sched.lr_mlp = 1e-3;
     m->points = (int)points, m->template_faces = (int)faces, m->poisson_depth = (int)depth;
     m->normals = ni, m->recon_points = (int)recon;
@@ -131,9 +129,9 @@ static int parse(const char *params_json, void *obj, tcb_error *err)
 
 static void release_model(neupig_method *m)
 {
-    free(m->params), free(m->deformed);
-    tcb_mesh_free(&m->template_mesh);
-    m->params = NULL, m->deformed = NULL;
+    free(m->params);
+    m->params = NULL;
+    tcb_pcgrid_fitted_release(&m->fitted);
 }
 
 static int create(const char *params_json, void **self, tcb_error *err)
@@ -155,10 +153,7 @@ static void destroy(void *self)
 /* ---- the inputs of an optimisation, rebuilt identically by fit and load ---- */
 
 typedef struct inputs {
-    int T;
-    float **clouds;      /* [T] → [n[t]][3] in the cube */
-    int *n;
-    tcb_nn **index;      /* [T] */
+    tcb_pcgrid_clouds c;
     float *vnormals;     /* [nv][3] the template's vertex normals */
     int32_t *edges;      /* [ne][2] */
     float *edge_len;     /* [ne] */
@@ -168,35 +163,9 @@ typedef struct inputs {
 
 static void inputs_free(inputs *in)
 {
-    for (int t = 0; in->clouds && t < in->T; t++) free(in->clouds[t]), tcb_nn_free(in->index[t]);
-    free(in->clouds), free(in->n), free(in->index), free(in->vnormals), free(in->edges), free(in->edge_len);
+    tcb_pcgrid_clouds_free(&in->c);
+    free(in->vnormals), free(in->edges), free(in->edge_len);
     memset(in, 0, sizeof *in);
-}
-
-/* Every frame's cloud of m->points from the pools, stream (seed,
- * "neupig/points"), then the map into the cube and the mapped clouds. */
-static int draw_clouds(neupig_method *m, const tcb_sequence *seq, uint64_t seed, inputs *in, tcb_error *err)
-{
-    in->T = seq->n_frames;
-    in->clouds = calloc((size_t)in->T, sizeof *in->clouds);
-    in->n = calloc((size_t)in->T, sizeof *in->n);
-    in->index = calloc((size_t)in->T, sizeof *in->index);
-    if (!in->clouds || !in->n || !in->index) return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
-    tcb_rng rng;
-    tcb_rng_seed_stream(&rng, seed, "neupig/points");
-    int rc = TCB_OK;
-    for (int t = 0; !rc && t < in->T; t++) {
-        in->n[t] = m->points;
-        if (!(in->clouds[t] = malloc((size_t)m->points * 3 * sizeof(float))))
-            return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
-        rc = tcb_sequence_draw_points(seq, t, m->points, seq->draw_with_replacement, &rng, in->clouds[t], err);
-    }
-    if (!rc) rc = tcb_pcgrid_frame_map_of((const float *const *)in->clouds, in->n, in->T, &m->map, err);
-    for (int t = 0; !rc && t < in->T; t++) {
-        tcb_pcgrid_map_points(&m->map, in->clouds[t], in->n[t], in->clouds[t]);
-        rc = tcb_nn_build(in->clouds[t], in->n[t], &in->index[t], err);
-    }
-    return rc;
 }
 
 /* Whether the keyframe's normals are GT's on seq: the "normals" param, or
@@ -214,23 +183,24 @@ static const char *normals_used(void *self, const tcb_sequence *seq)
 static int prepare(neupig_method *m, const tcb_sequence *seq, uint64_t seed, inputs *in, tcb_error *err)
 {
     memset(in, 0, sizeof *in);
-    tcb_mesh_free(&m->template_mesh);
+    tcb_mesh_free(&m->fitted.template_mesh);
     m->gt_normals = uses_gt_normals(m, seq);
-    int rc = draw_clouds(m, seq, seed, in, err);
+    /* every frame's cloud of m->points, stream (seed, "neupig/points") */
+    int rc = tcb_pcgrid_clouds_draw(seq, m->points, seed, "neupig/points", &m->fitted.map, &in->c, err);
     if (!rc)
-        rc = tcb_pcgrid_keyframe((const float *const *)in->clouds, in->n, in->T, TCB_PCGRID_KEYFRAME_RES, &in->key, err);
+        rc = tcb_pcgrid_keyframe((const float *const *)in->c.clouds, in->c.n, in->c.T, TCB_PCGRID_KEYFRAME_RES, &in->key, err);
     const tcb_pcgrid_template_spec spec = {
         .gt_normals = m->gt_normals, .poisson_depth = m->poisson_depth, .template_faces = m->template_faces};
     if (!rc)
-        rc = tcb_pcgrid_template_build(seq, in->key, &m->map, in->clouds[in->key], in->n[in->key], &spec,
-                                       &m->template_mesh, err);
-    const tcb_mesh *t = &m->template_mesh;
+        rc = tcb_pcgrid_template_build(seq, in->key, &m->fitted.map, in->c.clouds[in->key], in->c.n[in->key], &spec,
+                                       &m->fitted.template_mesh, err);
+    const tcb_mesh *t = &m->fitted.template_mesh;
     if (!rc) rc = tcb_pcgrid_template_normals(t, &in->vnormals, err);
     if (!rc) rc = tcb_pcgrid_template_edges(t, &in->edges, &in->edge_len, &in->ne, err);
     if (!rc)
         in->problem = (tcb_neupig_problem){t->n_verts, t->verts, in->vnormals, in->ne, in->edges, in->edge_len,
-                                           in->T, (const float *const *)in->clouds, in->n,
-                                           (const tcb_nn *const *)in->index, in->key};
+                                           in->c.T, (const float *const *)in->c.clouds, in->c.n,
+                                           (const tcb_nn *const *)in->c.index, in->key};
     if (rc) tcb_error_prefix(err, "neupig: ");
     return rc;
 }
@@ -239,12 +209,12 @@ static int prepare(neupig_method *m, const tcb_sequence *seq, uint64_t seed, inp
 static int deform_all(neupig_method *m, const inputs *in, tcb_error *err)
 {
     tcb_neupig_model model;
-    free(m->deformed);
-    m->n_frames = in->T;
-    m->deformed = malloc((size_t)in->T * (size_t)m->template_mesh.n_verts * 3 * sizeof(float));
-    if (!m->deformed) return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
+    free(m->fitted.deformed);
+    m->fitted.n_frames = in->c.T;
+    m->fitted.deformed = malloc((size_t)in->c.T * (size_t)m->fitted.template_mesh.n_verts * 3 * sizeof(float));
+    if (!m->fitted.deformed) return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
     int rc = tcb_neupig_model_init(&model, &m->arch, err);
-    if (!rc) rc = tcb_neupig_deform(&model, m->params, &in->problem, m->deformed, err);
+    if (!rc) rc = tcb_neupig_deform(&model, m->params, &in->problem, m->fitted.deformed, err);
     tcb_neupig_model_free(&model);
     return rc;
 }
@@ -280,7 +250,7 @@ static int fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_
     inputs in;
     fit_state s = {.seed = ctx->seed};
     int rc = prepare(m, seq, ctx->seed, &in, err);
-    if (!rc) rc = tcb_pcgrid_template_write(&m->template_mesh, &m->map, ctx->work_dir, in.key, err);
+    if (!rc) rc = tcb_pcgrid_template_write(&m->fitted.template_mesh, &m->fitted.map, ctx->work_dir, in.key, err);
     if (!rc) rc = tcb_neupig_trainer_init(&s.trainer, &m->arch, &m->sched, &in.problem, ctx->seed, err);
     if (!rc) {
         tcb_train_loop loop = {.name = "neupig", .iterations = m->sched.epochs, .checkpoint_every = m->checkpoint_every,
@@ -301,20 +271,6 @@ static int fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_
 
 /* ---- read-out ---- */
 
-static int check_frames(const neupig_method *m, const tcb_sequence *seq, int i, int j, tcb_error *err)
-{
-    if (!m->deformed) return tcb_fail(err, TCB_ERR_INTERNAL, "neupig: evaluation before fit or load");
-    if (i < 0 || j < 0 || i >= m->n_frames || j >= m->n_frames || seq->n_frames != m->n_frames)
-        return tcb_fail(err, TCB_ERR_INPUT, "neupig: pair %d->%d outside frames 0..%d of the fitted sequence", i, j,
-                        m->n_frames - 1);
-    return TCB_OK;
-}
-
-static const float *frame_of(const neupig_method *m, int f)
-{
-    return m->deformed + (size_t)f * (size_t)m->template_mesh.n_verts * 3;
-}
-
 static int steps_model(neupig_method *m, tcb_error *err);
 
 static int transfer(void *self, const tcb_sequence *seq, int i, int j, const float *src, int n, float *out,
@@ -323,19 +279,7 @@ static int transfer(void *self, const tcb_sequence *seq, int i, int j, const flo
     (void)rng;
     neupig_method *m = self;
     int rc = steps_model(m, err);
-    if (!rc) rc = check_frames(m, seq, i, j, err);
-    if (rc) return rc;
-    const tcb_mesh *t = &m->template_mesh;
-    tcb_surface_point *loc = malloc((size_t)n * sizeof *loc);
-    if (!loc) return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
-    tcb_pcgrid_map_points(&m->map, src, n, out);
-    rc = tcb_mesh_locate(frame_of(m, i), t->n_verts, t->faces, t->n_faces, out, n, loc, NULL, err);
-    if (!rc) {
-        tcb_surface_points(frame_of(m, j), t->faces, loc, n, out);
-        tcb_pcgrid_unmap_points(&m->map, out, n);
-    }
-    free(loc);
-    return rc;
+    return rc ? rc : tcb_pcgrid_transfer(&m->fitted, seq, i, j, src, n, out, err);
 }
 
 static int reconstruct(void *self, const tcb_sequence *seq, int i, int j, int frame, tcb_rng *rng, float **pts,
@@ -344,19 +288,7 @@ static int reconstruct(void *self, const tcb_sequence *seq, int i, int j, int fr
     neupig_method *m = self;
     *pts = NULL;
     int rc = steps_model(m, err);
-    if (!rc) rc = check_frames(m, seq, i, j, err);
-    if (rc) return rc;
-    const tcb_mesh *t = &m->template_mesh;
-    if (!(*pts = malloc((size_t)m->recon_points * 3 * sizeof **pts)))
-        return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
-    rc = tcb_sample_surface(frame_of(m, frame), t->faces, t->n_faces, m->recon_points, rng, *pts, err);
-    if (rc) {
-        free(*pts), *pts = NULL;
-        return rc;
-    }
-    tcb_pcgrid_unmap_points(&m->map, *pts, m->recon_points);
-    *n = m->recon_points;
-    return TCB_OK;
+    return rc ? rc : tcb_pcgrid_reconstruct(&m->fitted, seq, i, j, frame, m->recon_points, rng, pts, n, err);
 }
 
 /* The template deformed to `frame`, in the sequence's coordinates, without
@@ -368,20 +300,7 @@ static int surface(void *self, const tcb_sequence *seq, int frame, tcb_rng *rng,
     const tcb_uv_mesh none = {0, 0, 0, NULL, NULL, NULL, NULL};
     *out = none;
     int rc = steps_model(m, err);
-    if (!rc) rc = check_frames(m, seq, frame, frame, err);
-    if (rc) return rc;
-    const tcb_mesh *t = &m->template_mesh;
-    size_t vbytes = (size_t)t->n_verts * 3 * sizeof *out->verts, fbytes = (size_t)t->n_faces * 3 * sizeof *out->faces;
-    out->verts = malloc(vbytes), out->faces = malloc(fbytes);
-    if (!out->verts || !out->faces) {
-        tcb_uv_mesh_free(out);
-        return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
-    }
-    memcpy(out->verts, frame_of(m, frame), vbytes);
-    tcb_pcgrid_unmap_points(&m->map, out->verts, t->n_verts);
-    memcpy(out->faces, t->faces, fbytes);
-    out->n_verts = t->n_verts, out->n_faces = t->n_faces;
-    return TCB_OK;
+    return rc ? rc : tcb_pcgrid_surface(&m->fitted, seq, frame, out, err);
 }
 
 /* ---- the model file: the parameters under a manifest of the architecture ---- */
@@ -484,15 +403,15 @@ static int train_steps(void *self, const tcb_sequence *seq, const tcb_fit_ctx *c
     }
     double loss;
     for (long long k = 0; !rc && k < n; k++) rc = tcb_neupig_train_step(&m->steps->s.trainer, &loss, err);
-    free(m->deformed), free(m->params);
-    m->deformed = NULL, m->params = NULL; /* the model of fewer epochs */
+    free(m->fitted.deformed), free(m->params);
+    m->fitted.deformed = NULL, m->params = NULL; /* the model of fewer epochs */
     return rc;
 }
 
 /* The model of train_steps' epochs, once they stopped; nothing without. */
 static int steps_model(neupig_method *m, tcb_error *err)
 {
-    if (!m->steps || m->deformed) return TCB_OK;
+    if (!m->steps || m->fitted.deformed) return TCB_OK;
     const tcb_neupig_trainer *t = &m->steps->s.trainer;
     if (!(m->params = malloc(t->model.n_params * sizeof *m->params)))
         return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory");
@@ -508,11 +427,11 @@ static int run_unit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx,
 {
     if (unit != UNIT_TEMPLATE) return tcb_fail(err, TCB_ERR_INTERNAL, "neupig: no unit %d", unit);
     neupig_method scratch = *(const neupig_method *)self;
-    scratch.template_mesh = (tcb_mesh){0, 0, NULL, NULL};
+    scratch.fitted.template_mesh = (tcb_mesh){0, 0, NULL, NULL};
     inputs in;
     int rc = prepare(&scratch, seq, ctx->seed, &in, err);
     inputs_free(&in);
-    tcb_mesh_free(&scratch.template_mesh);
+    tcb_mesh_free(&scratch.fitted.template_mesh);
     return rc;
 }
 
