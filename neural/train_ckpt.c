@@ -137,7 +137,7 @@ int tcb_ckpt_spec_save(const tcb_ckpt_spec *s, double seconds, const char *path,
     const tcb_trainer_state *st = &s->state;
     tcb_ckpt_settings set = settings_of(s);
     tcb_train_progress p = {.it = *st->it, .adam_t = st->adam->t, .loss0 = *st->loss0, .seconds = seconds};
-    memcpy(p.rng, st->rng->s, sizeof p.rng);
+    if (st->rng) memcpy(p.rng, st->rng->s, sizeof p.rng); /* else zeros: a training that draws nothing */
     return tcb_train_ckpt_write(path, s->magic, &set, &p, s->arrays, s->n_arrays, err);
 }
 
@@ -148,7 +148,7 @@ int tcb_ckpt_spec_load(const tcb_ckpt_spec *s, const char *path, double *seconds
     tcb_train_progress p;
     int rc = tcb_train_ckpt_read(path, s->magic, s->what, &want, s->max_it, &p, s->arrays, s->n_arrays, err);
     if (rc) return rc;
-    memcpy(st->rng->s, p.rng, sizeof p.rng);
+    if (st->rng) memcpy(st->rng->s, p.rng, sizeof p.rng);
     *st->it = p.it, st->adam->t = p.adam_t, *st->loss0 = p.loss0;
     *seconds = p.seconds;
     return TCB_OK;

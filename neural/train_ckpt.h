@@ -71,8 +71,9 @@ int tcb_train_ckpt_read(const char *path, const char magic[8], const char *what,
                         const tcb_ckpt_array *arrays, int n_arrays, tcb_error *err);
 
 /* A trainer's progress where it keeps it, so that one call saves or
- * restores it: the iteration, the random stream, Adam (its step count; the
- * moments go in as arrays) and the first loss. */
+ * restores it: the iteration, the random stream (NULL for a training that
+ * draws nothing after its start), Adam (its step count; the moments go in
+ * as arrays) and the first loss. */
 typedef struct tcb_trainer_state {
     long long *it;
     tcb_rng *rng;

@@ -158,3 +158,20 @@ void tu_ref_trilinear(const double *values, int r, int F, const double p[3], dou
         for (int f = 0; f < F; f++) out[f] += w * v[f];
     }
 }
+
+double tu_ref_chamfer_way(const double *q, int nq, const double *to, int nt, const double *w_in, double *w_out)
+{
+    double sum = 0.0;
+    for (int i = 0; i < nq; i++) {
+        double best = INFINITY;
+        for (int j = 0; j < nt; j++) {
+            double s = 0.0;
+            for (int k = 0; k < 3; k++) s += (q[3 * i + k] - to[3 * j + k]) * (q[3 * i + k] - to[3 * j + k]);
+            best = fmin(best, s);
+        }
+        double w = w_in ? w_in[i] : exp(-best * best / (2.0 * 0.3 * 0.3));
+        if (w_out) w_out[i] = w;
+        sum += w * best;
+    }
+    return sum;
+}

@@ -55,6 +55,14 @@ void tu_fill_uniform(struct tcb_rng *r, float *x, size_t n, double lo, double hi
  * neural/lattice.c's tests and of the methods sampling lattices. */
 void tu_ref_trilinear(const double *values, int r, int F, const double p[3], double *out);
 
+/* One direction of the robust Chamfer (neural/robust_chamfer.h), in
+ * double with brute-force nearest neighbours: Σ_q w_q · min_t |q − t|²,
+ * w_q the Welsch weight exp(−s²/(2·0.3²)) of q's squared distance s. With
+ * w_in the weights are those (held, as the method holds them in its
+ * gradient); else they are computed, and stored into w_out when it is not
+ * NULL. */
+double tu_ref_chamfer_way(const double *q, int nq, const double *to, int nt, const double *w_in, double *w_out);
+
 /* 1 when nf triangles form closed surfaces, consistently oriented: every
  * directed edge occurs once and its reverse occurs too (so each undirected
  * edge has exactly two faces, wound opposite ways); 0 otherwise. */

@@ -43,22 +43,12 @@ static double sqd(const double *a, const double *b)
     return s;
 }
 
-static double ref_way(const double *q, int nq, const double *to, int nt, double *w, int replay)
-{
-    double sum = 0;
-    for (int i = 0; i < nq; i++) {
-        double best = INFINITY;
-        for (int j = 0; j < nt; j++) best = fmin(best, sqd(q + 3 * i, to + 3 * j));
-        if (!replay) w[i] = exp(-best * best / (2 * ALPHA * ALPHA));
-        sum += w[i] * best;
-    }
-    return sum;
-}
-
 static double ref_rc(tape *tp, const double *X, int nx, const double *P, int np)
 {
     double *w = tp->welsch[tp->at++];
-    return ref_way(X, nx, P, np, w, tp->replay) + ref_way(P, np, X, nx, w + nx, tp->replay);
+    const double *in = tp->replay ? w : NULL;
+    double *out = tp->replay ? NULL : w;
+    return tu_ref_chamfer_way(X, nx, P, np, in, out) + tu_ref_chamfer_way(P, np, X, nx, in ? in + nx : NULL, out ? out + nx : NULL);
 }
 
 static void ref_move(const tcb_pdg_fields *f, const double *V, int g, const double *x, int n, double *y)

@@ -18,29 +18,6 @@
 #define FD_H 1e-6
 enum { NX = 30, NP = 40 };
 
-static double sq(const double *a, const double *b)
-{
-    double s = 0.0;
-    for (int k = 0; k < 3; k++) s += (a[k] - b[k]) * (a[k] - b[k]);
-    return s;
-}
-
-/* One direction: Σ_q w_q · min_t |q − t|²; w NULL: compute the Welsch
- * weights into w_out instead of using frozen ones. */
-static double ref_way(const double *q, int nq, const double *to, int nt, const double *w,
-                      double *w_out)
-{
-    double sum = 0.0;
-    for (int i = 0; i < nq; i++) {
-        double best = INFINITY;
-        for (int j = 0; j < nt; j++) best = fmin(best, sq(q + 3 * i, to + 3 * j));
-        double wi = w ? w[i] : exp(-best * best / (2.0 * 0.3 * 0.3));
-        if (w_out) w_out[i] = wi;
-        sum += wi * best;
-    }
-    return sum;
-}
-
 static void test_chamfer(void **state)
 {
     (void)state;
@@ -55,13 +32,13 @@ static void test_chamfer(void **state)
     double cd;
     assert_int_equal(tcb_robust_chamfer(X, NX, P, NP, index, 0.3, &cd, dX, &err), TCB_OK);
     double *xd = tu_to_double(X, 3 * NX), *pd = tu_to_double(P, 3 * NP), wx[NX], wp[NP];
-    double ref = ref_way(xd, NX, pd, NP, NULL, wx) + ref_way(pd, NP, xd, NX, NULL, wp);
+    double ref = tu_ref_chamfer_way(xd, NX, pd, NP, NULL, wx) + tu_ref_chamfer_way(pd, NP, xd, NX, NULL, wp);
     assert_near(cd, ref, 1e-6 * ref);
     for (int e = 0; e < 3 * NX; e++) {
         double keep = xd[e], l[2];
         for (int s = 0; s < 2; s++) {
             xd[e] = keep + (s ? -FD_H : FD_H);
-            l[s] = ref_way(xd, NX, pd, NP, wx, NULL) + ref_way(pd, NP, xd, NX, wp, NULL);
+            l[s] = tu_ref_chamfer_way(xd, NX, pd, NP, wx, NULL) + tu_ref_chamfer_way(pd, NP, xd, NX, wp, NULL);
         }
         xd[e] = keep;
         double fd = (l[0] - l[1]) / (2.0 * FD_H);
