@@ -188,15 +188,28 @@ static int load_rows(const cJSON *root, const char *path, tcb_baseline *b, tcb_e
     return TCB_OK;
 }
 
+/* A /1 file's CD-L2 was ×1e3; the tables print ×1e5 now. */
+static void cdl2_from_v1(tcb_baseline *b)
+{
+    const double to_v2 = 100.0;
+    b->abs_tol[TCB_M_CDL2] *= to_v2;
+    for (int k = 0; k < b->n_rows; k++) {
+        tcb_baseline_row *r = &b->rows[k];
+        r->abs_tol[TCB_M_CDL2] *= to_v2;
+        if (r->has[TCB_M_CDL2]) r->value[TCB_M_CDL2] *= to_v2;
+    }
+}
+
 static int baseline_from_json(const cJSON *root, const char *path, tcb_baseline *b,
                               tcb_error *err)
 {
     int rc = tcb_json_expect_object(root, path, err);
     if (rc) return rc;
     const cJSON *format = cJSON_GetObjectItemCaseSensitive(root, "format");
-    if (!cJSON_IsString(format) || strcmp(format->valuestring, TCB_BASELINE_FORMAT))
-        return tcb_fail(err, TCB_ERR_INPUT, "%s: format: expected \"%s\"", path,
-                        TCB_BASELINE_FORMAT);
+    int v1 = cJSON_IsString(format) && !strcmp(format->valuestring, TCB_BASELINE_FORMAT_V1);
+    if (!v1 && (!cJSON_IsString(format) || strcmp(format->valuestring, TCB_BASELINE_FORMAT)))
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: format: expected \"%s\" (or \"%s\")", path,
+                        TCB_BASELINE_FORMAT, TCB_BASELINE_FORMAT_V1);
     for (const cJSON *item = root->child; item; item = item->next) {
         int known = 0;
         for (int k = 0; TOP_KEYS[k]; k++) known |= !strcmp(item->string, TOP_KEYS[k]);
@@ -205,8 +218,9 @@ static int baseline_from_json(const cJSON *root, const char *path, tcb_baseline 
                             "%s: %s: unknown key (expected format, tolerances, rows)", path,
                             item->string);
     }
-    if ((rc = load_tolerances(root, path, b, err))) return rc;
-    return load_rows(root, path, b, err);
+    if ((rc = load_tolerances(root, path, b, err)) || (rc = load_rows(root, path, b, err))) return rc;
+    if (v1) cdl2_from_v1(b);
+    return TCB_OK;
 }
 
 int tcb_baseline_load(const char *path, tcb_baseline *out, tcb_error *err)

@@ -22,7 +22,11 @@
 
 #include "reports/aggregate.h"
 
-#define TCB_BASELINE_FORMAT "tcbench-baseline/1"
+/* /2 from 2026-12-05: CD-L2 ×1e5 (the papers' scale). A /1 file, CD-L2
+ * ×1e3, still loads: its CD-L2 values and absolute tolerances are scaled
+ * by 100 as it is read. */
+#define TCB_BASELINE_FORMAT "tcbench-baseline/2"
+#define TCB_BASELINE_FORMAT_V1 "tcbench-baseline/1"
 
 typedef struct tcb_baseline_row {
     char dataset[64];
