@@ -1,0 +1,104 @@
+"""PDG's objective and its template term in PyTorch autograd, written from
+the method's description (github vc-bonn/preconditioned-deformation-grids
+@ cf21c7d: src/optimization.py, src/geometry/; grids from vc-bonn/pcgrid
+@ 28a3b11: src/pcgrid/grid.py, optimization_values.py; the robust Chamfer
+from DynoSurf's code/loss.py): the reference of tests/pytorch/
+pdg_step_check.py, in float64 with dense solves on small grids.
+
+Every operation is the reference's: per transition and level, the values
+V = M^-1 U with M = I + lambda_l L (pcgrid's lattice Laplacian, its
+diagonal the occurrences in a both-way edge list: neupig_torch.laplacian);
+grid_sample with align_corners=True and border padding, the level mean,
+the translation 0.1 tanh (the release's rotation never leaves zero); the
+template v = (I + 16 L)^-1 u with L the uniform Laplacian of its edges;
+the robust Chamfer (sums, Welsch weight of the squared distance, detached);
+the input term, the chains from the detached template sampled at the moved
+points, the catch-up weights (detached), 250 x the edge-length L1 between
+consecutive steps.
+"""
+import torch
+import torch.nn.functional as F
+
+import neupig_torch as nt
+
+
+def field_values(U_levels, lambdas):
+    """V per level [T][r^3][3] from U per level (level 0, one node: M = I)."""
+    out = []
+    for U, lam in zip(U_levels, lambdas):
+        n = U.shape[1]
+        r = round(n ** (1 / 3))
+        if r == 1:
+            out.append(U)
+            continue
+        M = torch.eye(n) + lam * nt.laplacian(r)
+        out.append(torch.stack([torch.linalg.solve(M, U[g]) for g in range(U.shape[0])]))
+    return out
+
+
+def uniform_laplacian(faces, nv):
+    L = torch.zeros((nv, nv))
+    edges = {tuple(sorted((int(f[a]), int(f[(a + 1) % 3])))) for f in faces for a in range(3)}
+    for a, b in edges:
+        L[a, b] = L[b, a] = -1
+        L[a, a] += 1
+        L[b, b] += 1
+    return L, sorted(edges)
+
+
+def sample(V, x):
+    """V [r^3][3] (x fastest) at points x [n][3]: [n][3]."""
+    r = round(V.shape[0] ** (1 / 3))
+    vol = V.reshape(r, r, r, 3).permute(3, 0, 1, 2)[None]  # [1][3][z][y][x]
+    out = F.grid_sample(vol, x[None, None, None], mode="bilinear", padding_mode="border", align_corners=True)
+    return out[0, :, 0, 0].T
+
+
+def move(V_levels, g, x):
+    s = sum(sample(V[g], x) for V in V_levels) / len(V_levels)
+    return x + 0.1 * torch.tanh(s)
+
+
+def robust_chamfer(X, P, alpha=0.3):
+    d2 = torch.cdist(X, P) ** 2
+    sx, sp = d2.min(dim=1).values, d2.min(dim=0).values
+    w = lambda s: torch.exp(-s * s / (2 * alpha * alpha)).detach()
+    return (w(sx) * sx).sum() + (w(sp) * sp).sum()
+
+
+def edge_l1(x, prev, edges):
+    a, b = edges[:, 0], edges[:, 1]
+    return (torch.linalg.norm(x[a] - x[b], dim=1) - torch.linalg.norm(prev[a] - prev[b], dim=1)).abs().mean()
+
+
+def objective(V_levels, v, P, key, edges, epoch, epochs, warmup, edge_w=250.0):
+    """(total, input, pred, edge) of one epoch; v the template (detached here)."""
+    n = len(P)
+    T = n - 1
+    L_in = sum(robust_chamfer(move(V_levels, g, P[g + 1 if g < key else g]), P[g if g < key else g + 1])
+               for g in range(T)) / T
+    zero = torch.zeros(())
+    if epoch < warmup:
+        return L_in, L_in, zero, zero
+    v = v.detach()
+    lens = [key, n - 1 - key]
+    M = max(lens)
+    x = [v, v]
+    e = 1 - (epoch / epochs) ** 0.5
+    s, S = 1.0, 0.0
+    pred, edge = zero, zero
+    for m in range(1, M + 1):
+        live = [k for k in range(2) if lens[k] >= m]
+        CD, E = zero, zero
+        for k in live:
+            g, t = (key - m, key - m) if k == 0 else (key + m - 1, key + m)
+            nx = move(V_levels, g, x[k])
+            CD = CD + robust_chamfer(nx, P[t]) / len(live)
+            E = E + edge_l1(nx, x[k], edges) / len(live)
+            x[k] = nx
+        c = s ** e
+        pred = pred + c * CD / M
+        edge = edge + edge_w * E / M
+        S += c * CD.item()
+        s /= max(1.0, 1.0 + S - L_in.item())
+    return L_in + pred + edge, L_in, pred, edge
