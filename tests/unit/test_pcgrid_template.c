@@ -102,7 +102,7 @@ static void test_both_templates(void **state)
     body *b = *state;
     tcb_pcgrid_template_spec neupig = {.gt_normals = 1, .poisson_depth = 8, .template_faces = FACES};
     tcb_pcgrid_template_spec pdg = neupig;
-    pdg.remesh_iterations = 5, pdg.check_samples = 20000, pdg.max_rounds = 10, pdg.check_chamfer = 5e-4;
+    pdg.remesh_iterations = 5, pdg.check_samples = 10000, pdg.max_rounds = 10, pdg.check_chamfer = 5e-4;
     tcb_mesh a, c;
     build_ok(b, &neupig, &a);
     build_ok(b, &pdg, &c);
