@@ -85,14 +85,20 @@ static void steps(tcb_pdg_trainer *t, int n, double *loss)
         if (tcb_pdg_train_step(t, loss, &err)) fail_msg("%s", err.msg);
 }
 
+/* The fixture and a trainer of the small architecture on it. */
+static void begin(fixture *f, tcb_pdg_trainer *t)
+{
+    build(f);
+    tcb_pdg_arch a = small_arch();
+    start(t, &a, f);
+}
+
 static void test_loss_falls(void **state)
 {
     (void)state;
     fixture f;
-    build(&f);
-    tcb_pdg_arch a = small_arch();
     tcb_pdg_trainer t;
-    start(&t, &a, &f);
+    begin(&f, &t);
     double first, warm, after, last;
     steps(&t, 1, &first);
     steps(&t, 19, &warm);
@@ -172,10 +178,9 @@ static void test_template_gradient(void **state)
 {
     (void)state;
     fixture f;
-    build(&f);
-    tcb_pdg_arch a = small_arch();
     tcb_pdg_trainer t;
-    start(&t, &a, &f);
+    begin(&f, &t);
+    const tcb_pdg_arch a = t.arch;
     double loss;
     steps(&t, 1, &loss); /* the step leaves its gradient in grads: du at the start's u */
     size_t nf = t.fields.off[t.fields.levels];
