@@ -29,9 +29,8 @@ static void chains_free(chain c[2])
     memset(c, 0, 2 * sizeof *c);
 }
 
-/* Both chains run forward from v; grad allocated (zero) when with_grad. */
-static int chains_run(const tcb_pdg_fields *f, const float *V, const tcb_pdg_problem *p, int with_grad, chain c[2],
-                      tcb_error *err)
+/* Both chains run forward from v, their gradients zeroed. */
+static int chains_run(const tcb_pdg_fields *f, const float *V, const tcb_pdg_problem *p, chain c[2], tcb_error *err)
 {
     memset(c, 0, 2 * sizeof *c);
     size_t frame = (size_t)p->nv * 3;
@@ -40,8 +39,8 @@ static int chains_run(const tcb_pdg_fields *f, const float *V, const tcb_pdg_pro
         c[k].len = k ? p->n - 1 - p->key : p->key;
         c[k].x = malloc((size_t)(c[k].len + 1) * frame * sizeof *c[k].x);
         c[k].s = malloc((size_t)(c[k].len ? c[k].len : 1) * frame * sizeof *c[k].s);
-        c[k].grad = with_grad ? calloc((size_t)(c[k].len + 1) * frame, sizeof *c[k].grad) : NULL;
-        if (!c[k].x || !c[k].s || (with_grad && !c[k].grad)) {
+        c[k].grad = calloc((size_t)(c[k].len + 1) * frame, sizeof *c[k].grad);
+        if (!c[k].x || !c[k].s || !c[k].grad) {
             chains_free(c);
             return tcb_fail(err, TCB_ERR_NOMEM, "pdg: out of memory for the chains");
         }
@@ -171,7 +170,7 @@ int tcb_pdg_loss_grad(const tcb_pdg_fields *f, const float *V, const tcb_pdg_pro
     out->total = out->input;
     if (rc || epoch < w->warmup) return rc;
     chain c[2];
-    if ((rc = chains_run(f, V, p, 1, c, err))) return rc;
+    if ((rc = chains_run(f, V, p, c, err))) return rc;
     rc = chain_terms(p, w, epoch, epochs, out->input, c, out, err);
     size_t frame = (size_t)p->nv * 3;
     float *ds = rc ? NULL : malloc(frame * sizeof *ds);
