@@ -177,3 +177,16 @@ int tcb_model_file_read(const char *path, const char magic[8], const cJSON *want
     free(buf);
     return rc;
 }
+
+int tcb_model_file_seed(const char *path, const char magic[8], uint64_t *seed, tcb_error *err)
+{
+    unsigned char head[HDR];
+    FILE *f = fopen(path, "rb");
+    if (!f) return tcb_fail(err, TCB_ERR_IO, "%s: cannot open", path);
+    size_t got = fread(head, 1, HDR, f);
+    fclose(f);
+    if (got < HDR || memcmp(head, magic, 8))
+        return tcb_fail(err, TCB_ERR_INPUT, "%s: not a %.8s model checkpoint (bad magic or length)", path, magic);
+    memcpy(seed, head + 8, 8);
+    return TCB_OK;
+}

@@ -65,4 +65,8 @@ int tcb_model_file_write(const char *path, const char magic[8], uint64_t seed, c
 int tcb_model_file_read(const char *path, const char magic[8], const cJSON *want, uint64_t *seed,
                         const tcb_weight_parts *w, tcb_error *err);
 
+/* The fit's seed alone, for a method whose sizes follow from what the seed
+ * rebuilds (PDG's template); a bad magic is TCB_ERR_INPUT naming the file. */
+int tcb_model_file_seed(const char *path, const char magic[8], uint64_t *seed, tcb_error *err);
+
 #endif
