@@ -1,7 +1,9 @@
 """What bench_train_step's PyTorch peers share: torch and their reference
-module from tests/pytorch (exit 77, and a message on stderr, when either
-cannot be imported: the bench then prints n/a), and the timing they
-print, one line "<mean ms per step> <peak RSS of this process in KiB>"."""
+modules from tests/pytorch (exit 77, and a message on stderr, when one
+cannot be imported: the bench then prints n/a), the allocator's setting,
+a mesh's edges, and the timing they print, one line "<mean ms per step> <peak RSS of this process
+in KiB>"."""
+import ctypes
 import importlib
 import os
 import resource
@@ -11,16 +13,36 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
-def import_reference(name):
-    """(torch, the module tests/pytorch/<name>.py)."""
+def import_reference(*names):
+    """(torch, the modules `names`): tests/pytorch/<name>.py, or any other
+    module a peer needs (scipy's)."""
     sys.path.insert(0, os.path.join(HERE, "..", "tests", "pytorch"))
     try:
         import torch
 
-        return torch, importlib.import_module(name)
+        return (torch,) + tuple(importlib.import_module(name) for name in names)
     except ImportError as exc:
         print(f"unavailable: {exc}", file=sys.stderr)
         sys.exit(77)
+
+
+def keep_freed_memory():
+    """Has glibc keep freed memory for reuse. It hands every freed block
+    over 32 MiB back to the kernel, so that each new distance matrix of a
+    nearest-neighbour search (tens to hundreds of MB) is faulted in page by
+    page again: most of an epoch on a loaded 2-core machine. PyTorch's CPU
+    tuning guide swaps in a caching allocator (jemalloc, tcmalloc) for
+    this; mallopt does it without one."""
+    libc = ctypes.CDLL("libc.so.6")
+    M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3
+    libc.mallopt(M_MMAP_THRESHOLD, 1 << 30)
+    libc.mallopt(M_TRIM_THRESHOLD, 1 << 30)
+
+
+def edges(faces):
+    """The undirected edges [ne][2] (smaller index first, each once) of
+    the triangles faces [nf][3] (a long tensor)."""
+    return faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2).sort(1).values.unique(dim=0)
 
 
 def time_steps(step, warmup, iters):

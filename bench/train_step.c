@@ -48,18 +48,40 @@
  * backward; the grids, the Chamfer's nearest neighbours, the edge term and
  * Adam are timed but not counted.
  *
- * Targets (issues 3, 14, 28): C ≥ 4× faster than PyTorch for the mca step at
- * paper scale, ≥ 3× for atlasnet, cc and neupig, the step at ≥ 60 % of
- * peak. Timings only; nothing is asserted.
+ * pdg (one epoch of tcb_pdg_train_step after the warm-up: the input term
+ * over the 5 transitions, both chains from the keyframe with their catch-up
+ * weights and edge term, the template's robust Chamfer through its Large-
+ * Steps solve, backward, Adam) at the paper preset (10 levels, 5 000
+ * points a frame, a template of up to 20 000 triangles) and the cpu
+ * preset's (10 levels, 2 500 points, up to 10 000 triangles), on the
+ * calibration sequence's 6 frames. Created with {"preset": P, "warmup":
+ * 0}, so that every timed epoch has every term: the 101 warm-up epochs
+ * (the input term alone) are 2 % of a paper fit and 10 % of a cpu one,
+ * and what `tcbench calibrate` times. The peer train_step_pdg_torch.py
+ * (tests/pytorch/pdg_torch.py's reference loss, float32, torch.optim.Adam
+ * with the per-level rates) trains on the C training's own data, written
+ * to a temporary directory: every frame's cloud in the fields' cube, the
+ * keyframe, the template as it started. --losses prints the loss parts of
+ * both sides' first two epochs on stderr (C's from two more, untimed,
+ * epochs before the timed ones): the same epochs on the same data give the
+ * same numbers. No GFLOP count ("-"): the epoch is nearest-neighbour
+ * searches, scattered trilinear samples and small solves, no product a
+ * FLOP peak would measure.
+ *
+ * Targets (issues 3, 14, 28, 40): C ≥ 4× faster than PyTorch for the mca
+ * step at paper scale, ≥ 3× for atlasnet, cc, neupig and pdg, the step at
+ * ≥ 60 % of peak. Timings only; nothing is asserted.
  *
  * usage: bench_train_step [--iters N] [--threads T] [--preset paper|cpu|all]
  *                         [--method NAME] [--peak GFLOPS] [--no-torch]
  *                         [--torch SCRIPT] [--cc-torch SCRIPT]
- *                         [--neupig-torch SCRIPT]
+ *                         [--neupig-torch SCRIPT] [--pdg-torch SCRIPT]
+ *                         [--losses]
  * Defaults: 5 iterations, the OpenMP thread count, all presets and methods
- * (atlasnet, dsr, mca, cc, neupig), the peers train_step_torch.py,
- * train_step_cc_torch.py and train_step_neupig_torch.py next to this file
- * run by /usr/bin/python3. */
+ * (atlasnet, dsr, mca, cc, neupig, pdg), the peers train_step_torch.py,
+ * train_step_cc_torch.py, train_step_neupig_torch.py and
+ * train_step_pdg_torch.py next to this file run by /usr/bin/python3. */
+#include <dirent.h>
 #include <math.h>
 #include <omp.h>
 #include <stdarg.h>
@@ -72,10 +94,15 @@
 #include "atlas_bench.h"
 #include "cc_bench.h"
 #include "costs/step_timing.h"
+#include "methods/pcgrid/method.h"
+#include "methods/pdg/train.h"
 #include "tcb/mesh_io.h"
+#include "tcb/npy.h"
 #include "tcb/registry.h"
 
-enum { P = 10, N = TCB_DEFAULT_INPUT_POINTS, PEER_SKIPPED = 77 };
+/* LOSS_EPOCHS: the epochs whose losses --losses prints: the first at zero
+ * fields, the second after a step (solves, gradients and Adam). */
+enum { P = 10, N = TCB_DEFAULT_INPUT_POINTS, PEER_SKIPPED = 77, LOSS_EPOCHS = 2 };
 
 typedef struct {
     const char *name;
@@ -108,50 +135,76 @@ static const struct {
 } methods[] = {{"atlasnet", 0}, {"dsr", 2}, {"mca", 2}};
 
 typedef struct {
-    int iters, threads, torch;
+    int iters, threads, torch, losses;
     double peak;
     const char *preset; /* NULL: all */
     const char *method; /* NULL: all */
-    char script[4096], cc_script[4096], neupig_script[4096];
+    char script[4096], cc_script[4096], neupig_script[4096], pdg_script[4096];
 } options;
 
 #define die(...) bench_die("bench_train_step", __VA_ARGS__)
 
-/* Mean ms per training step of method `name` at `preset`, after one
- * warm-up step: the measurement `tcbench calibrate` makes
- * (tcb_time_train_steps through the method's train_steps). With obj_path,
- * the trained model's surface of frame 0 is written there as an OBJ and
- * its vertex count to *nv. */
-static double time_c_surface(const char *name, const char *preset, const tcb_sequence *seq, const options *o,
-                             const char *obj_path, int *nv)
+/* Method `name` created with {"preset": preset<more>}; *ops its table. */
+static void *create_at(const char *name, const char *preset, const char *more, const tcb_method_ops **ops)
 {
-    const tcb_method_ops *ops = tcb_registry_find(name);
-    char params[64];
-    snprintf(params, sizeof params, "{\"preset\": \"%s\"}", preset);
+    char params[128];
+    snprintf(params, sizeof params, "{\"preset\": \"%s\"%s}", preset, more);
     tcb_error err = {0};
     void *self;
-    if (!ops || ops->create(params, &self, &err)) die("%s: %s", name, ops ? err.msg : "not registered");
-    if (ops->abi_version < 5 || !ops->train_steps) die("%s: no train_steps in its table", name);
+    *ops = tcb_registry_find(name);
+    if (!*ops || (*ops)->create(params, &self, &err)) die("%s: %s", name, *ops ? err.msg : "not registered");
+    if ((*ops)->abi_version < 5 || !(*ops)->train_steps) die("%s: no train_steps in its table", name);
+    return self;
+}
+
+/* Mean ms per training step of a created method, after one warm-up step:
+ * the measurement `tcbench calibrate` makes (tcb_time_train_steps through
+ * the method's train_steps). */
+static double time_steps(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, const options *o)
+{
     tcb_fit_ctx ctx = {.seed = 1, .n_threads = o->threads};
     tcb_step_timing t;
+    tcb_error err = {0};
     if (tcb_time_train_steps(ops, self, seq, &ctx, o->iters, INFINITY, &t, &err)) die("%s", err.msg);
-    if (obj_path) {
-        tcb_uv_mesh m = {0, 0, 0, NULL, NULL, NULL, NULL};
-        tcb_rng rng;
-        tcb_rng_seed_stream(&rng, 1, "bench/surface");
-        if (ops->abi_version < 3 || !ops->surface) die("%s: no surface in its table", name);
-        if (ops->surface(self, seq, 0, &rng, &m, &err) || tcb_obj_write(obj_path, m.verts, m.n_verts, m.faces, m.n_faces, &err))
-            die("%s: %s", name, err.msg);
-        *nv = m.n_verts;
-        tcb_uv_mesh_free(&m);
-    }
-    ops->destroy(self);
     return t.step_s * 1e3;
 }
 
+/* time_steps of method `name` created at `preset`. */
 static double time_c(const char *name, const char *preset, const tcb_sequence *seq, const options *o)
 {
-    return time_c_surface(name, preset, seq, o, NULL, NULL);
+    const tcb_method_ops *ops;
+    void *self = create_at(name, preset, "", &ops);
+    double ms = time_steps(ops, self, seq, o);
+    ops->destroy(self);
+    return ms;
+}
+
+/* The surface of frame 0 of a method trained by train_steps, as an OBJ at
+ * path; its vertex count. */
+static int write_surface(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, const char *path)
+{
+    tcb_uv_mesh m = {0, 0, 0, NULL, NULL, NULL, NULL};
+    tcb_rng rng;
+    tcb_error err = {0};
+    tcb_rng_seed_stream(&rng, 1, "bench/surface");
+    if (ops->abi_version < 3 || !ops->surface) die("%s: no surface in its table", ops->name);
+    if (ops->surface(self, seq, 0, &rng, &m, &err) || tcb_obj_write(path, m.verts, m.n_verts, m.faces, m.n_faces, &err))
+        die("%s: %s", ops->name, err.msg);
+    int nv = m.n_verts;
+    tcb_uv_mesh_free(&m);
+    return nv;
+}
+
+/* Removes the temporary directory dir and the files in it. */
+static void remove_dir(const char *dir)
+{
+    char path[4096];
+    DIR *d = opendir(dir);
+    for (struct dirent *e; d && (e = readdir(d));)
+        if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
+            snprintf(path, sizeof path, "%s/%s", dir, e->d_name), remove(path);
+    if (d) closedir(d);
+    remove(dir);
 }
 
 /* Runs a PyTorch peer command: 0 with *ms and *rss_kib, PEER_SKIPPED when
@@ -197,6 +250,41 @@ static int time_neupig_torch(const options *o, const neupig_preset *pr, const ch
     return run_peer(cmd, ms, rss_kib);
 }
 
+/* [rows][3] of data as dir/name.npy. */
+static int save_rows(const char *dir, const char *name, tcb_npy_dtype dtype, int rows, const void *data, tcb_error *err)
+{
+    char path[128];
+    const uint64_t shape[2] = {(uint64_t)rows, 3};
+    snprintf(path, sizeof path, "%s/%s.npy", dir, name);
+    return tcb_npy_save(path, dtype, 2, shape, data, err);
+}
+
+/* The pdg peer's data and command: pdg's training of train_steps (self)
+ * written to a new temporary directory dir, its clouds in the fields' cube
+ * (points_<t>.npy) and its template as it started (template_verts.npy,
+ * template_faces.npy); its keyframe, epochs and levels on the command
+ * line. -1 when the command does not fit. */
+static int pdg_peer(const options *o, const void *self, char *dir, char *cmd, size_t size)
+{
+    const void *state;
+    const tcb_pcgrid_inputs *in = tcb_pcgrid_steps_inputs(self, &state);
+    const tcb_pdg_trainer *t = state;
+    const tcb_mesh *m = in->template_mesh;
+    tcb_error err = {0};
+    if (!mkdtemp(dir)) die("cannot create a temporary directory in /tmp");
+    int rc = save_rows(dir, "template_verts", TCB_NPY_F4, m->n_verts, m->verts, &err);
+    if (!rc) rc = save_rows(dir, "template_faces", TCB_NPY_I4, m->n_faces, m->faces, &err);
+    for (int k = 0; !rc && k < in->clouds.T; k++) {
+        char name[32];
+        snprintf(name, sizeof name, "points_%d", k);
+        rc = save_rows(dir, name, TCB_NPY_F4, in->clouds.n[k], in->clouds.clouds[k], &err);
+    }
+    if (rc) die("pdg: %s", err.msg);
+    return (size_t)snprintf(cmd, size, "/usr/bin/python3 '%s' '%s' %d %d %lld %d %d %d%s", o->pdg_script, dir,
+                            in->clouds.T, in->key, t->sched.epochs, t->arch.levels, o->iters, o->threads,
+                            o->losses ? " --losses" : "") < size ? 0 : -1;
+}
+
 static double peak_rss_mib(void)
 {
     struct rusage ru;
@@ -217,17 +305,20 @@ static void print_header(const options *o)
            "  + B*N*sum_l(din^2 + din*dout); backward ~2x.\n"
            "neupig (one epoch: every frame; tcb_neupig_train_step): the MLP T*nv*(Din*H + H^2 + 7H),\n"
            "  backward 2x; grids, Chamfer and edge terms not counted.\n"
+           "pdg (one epoch after the warm-up: every transition and chain; tcb_pdg_train_step): not counted (-).\n"
            "Losses, nearest neighbours and Adam not counted. Peak %.0f GFLOP/s.\n", P, N, o->peak);
     printf("%-6s %-9s %8s %9s %8s %6s %10s %8s %9s %9s\n", "preset", "method", "GFLOP/it", "C ms/it", "GFLOP/s",
            "%peak", "torch ms", "torch/C", "C RSS MiB", "torch MiB");
 }
 
-/* One row: the C figures and the peer's (rc 0), or n/a. */
+/* One row: the C figures and the peer's (rc 0), or n/a; gflop < 0: not
+ * counted. */
 static void print_row(options *o, const char *preset, const char *method, double gflop, double ms, int rc,
                       double tms, long rss, const char *script)
 {
     double gfs = gflop / ms * 1e3, c_rss = peak_rss_mib();
-    printf("%-6s %-9s %8.1f %9.1f %8.1f %5.0f%%", preset, method, gflop, ms, gfs, 100 * gfs / o->peak);
+    if (gflop < 0) printf("%-6s %-9s %8s %9.1f %8s %6s", preset, method, "-", ms, "-", "-");
+    else printf("%-6s %-9s %8.1f %9.1f %8.1f %5.0f%%", preset, method, gflop, ms, gfs, 100 * gfs / o->peak);
     if (rc == 0) printf(" %10.1f %8.2f %9.0f %9.0f\n", tms, tms / ms, c_rss, rss / 1024.0);
     else printf(" %10s %8s %9.0f %9s\n", "n/a", "n/a", c_rss, "n/a");
     if (rc == PEER_SKIPPED && o->torch) {
@@ -266,13 +357,52 @@ static void run_neupig_row(options *o, const preset *p, const neupig_preset *pr,
     char dir[] = "/tmp/bench_train_step_XXXXXX", obj[64];
     if (!mkdtemp(dir)) die("cannot create a temporary directory in /tmp");
     snprintf(obj, sizeof obj, "%s/template.obj", dir);
-    int nv = 0;
-    double tms = 0, ms = time_c_surface("neupig", p->name, seq, o, obj, &nv);
+    const tcb_method_ops *ops;
+    void *self = create_at("neupig", p->name, "", &ops);
+    double tms = 0, ms = time_steps(ops, self, seq, o);
+    int nv = write_surface(ops, self, seq, obj);
+    ops->destroy(self);
     long rss = 0;
     int rc = o->torch ? time_neupig_torch(o, pr, obj, seq->n_frames, &tms, &rss) : PEER_SKIPPED;
-    remove(obj), remove(dir);
+    remove_dir(dir);
     double fwd = (double)seq->n_frames * nv * ((double)pr->din * pr->hidden + (double)pr->hidden * pr->hidden + 7.0 * pr->hidden);
     print_row(o, p->name, "neupig", 2 * 3 * fwd * 1e-9, ms, rc, tms, rss, o->neupig_script);
+}
+
+/* --losses: LOSS_EPOCHS untimed epochs of pdg's train_steps, their loss
+ * parts on stderr (the peer prints its first epochs'). */
+static void print_losses(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, const options *o)
+{
+    tcb_fit_ctx ctx = {.seed = 1, .n_threads = o->threads};
+    tcb_error err = {0};
+    const void *state;
+    fflush(stdout); /* after the header, in one log */
+    for (int k = 0; k < LOSS_EPOCHS; k++) {
+        if (ops->train_steps(self, seq, &ctx, 1, &err)) die("pdg: %s", err.msg);
+        tcb_pcgrid_steps_inputs(self, &state);
+        const tcb_pdg_trainer *t = state;
+        fprintf(stderr, "pdg epoch %d, C:     total %.7g input %.7g pred %.7g edge %.7g template %.7g\n", k,
+                t->last.total, t->last.input, t->last.pred, t->last.edge, t->template_loss);
+    }
+}
+
+/* pdg at preset p, every term from the first epoch (the header); the peer
+ * on the C training's data. */
+static void run_pdg_row(options *o, const preset *p, const tcb_sequence *seq)
+{
+    const tcb_method_ops *ops;
+    void *self = create_at("pdg", p->name, ", \"warmup\": 0", &ops);
+    if (o->losses) print_losses(ops, self, seq, o);
+    double tms = 0, ms = time_steps(ops, self, seq, o);
+    char dir[] = "/tmp/bench_train_step_XXXXXX", cmd[8192];
+    int rc = o->torch ? pdg_peer(o, self, dir, cmd, sizeof cmd) : PEER_SKIPPED;
+    ops->destroy(self);
+    long rss = 0;
+    if (o->torch) {
+        if (rc == 0) rc = run_peer(cmd, &tms, &rss);
+        remove_dir(dir);
+    }
+    print_row(o, p->name, "pdg", -1, ms, rc, tms, rss, o->pdg_script);
 }
 
 static void parse(int argc, char **argv, options *o)
@@ -281,9 +411,11 @@ static void parse(int argc, char **argv, options *o)
     bench_sibling_path(o->script, sizeof o->script, __FILE__, "train_step_torch.py");
     bench_sibling_path(o->cc_script, sizeof o->cc_script, __FILE__, "train_step_cc_torch.py");
     bench_sibling_path(o->neupig_script, sizeof o->neupig_script, __FILE__, "train_step_neupig_torch.py");
+    bench_sibling_path(o->pdg_script, sizeof o->pdg_script, __FILE__, "train_step_pdg_torch.py");
     for (int a = 1; a < argc; a++) {
         const char *v = a + 1 < argc ? argv[a + 1] : NULL;
         if (strcmp(argv[a], "--no-torch") == 0) o->torch = 0;
+        else if (strcmp(argv[a], "--losses") == 0) o->losses = 1;
         else if (!v) die("bad argument %s (usage: top of bench/train_step.c)", argv[a]);
         else if (strcmp(argv[a], "--iters") == 0) o->iters = bench_positive_int(v, "--iters", "top of bench/train_step.c"), a++;
         else if (strcmp(argv[a], "--threads") == 0) o->threads = bench_positive_int(v, "--threads", "top of bench/train_step.c"), a++;
@@ -296,6 +428,8 @@ static void parse(int argc, char **argv, options *o)
             snprintf(o->cc_script, sizeof o->cc_script, "%s", v), a++;
         else if (strcmp(argv[a], "--neupig-torch") == 0)
             snprintf(o->neupig_script, sizeof o->neupig_script, "%s", v), a++;
+        else if (strcmp(argv[a], "--pdg-torch") == 0)
+            snprintf(o->pdg_script, sizeof o->pdg_script, "%s", v), a++;
         else die("bad argument %s (usage: top of bench/train_step.c)", argv[a]);
     }
     if (o->iters < 1 || o->threads < 1 || o->peak <= 0)
@@ -303,8 +437,8 @@ static void parse(int argc, char **argv, options *o)
     if (o->preset && strcmp(o->preset, "cpu") && strcmp(o->preset, "paper"))
         die("--preset must be paper, cpu or all");
     if (o->method && strcmp(o->method, "atlasnet") && strcmp(o->method, "dsr") && strcmp(o->method, "mca") &&
-        strcmp(o->method, "cc") && strcmp(o->method, "neupig"))
-        die("--method must be atlasnet, dsr, mca, cc or neupig");
+        strcmp(o->method, "cc") && strcmp(o->method, "neupig") && strcmp(o->method, "pdg"))
+        die("--method must be atlasnet, dsr, mca, cc, neupig or pdg");
 }
 
 int main(int argc, char **argv)
@@ -323,6 +457,7 @@ int main(int argc, char **argv)
             if (!o.method || strcmp(o.method, methods[k].name) == 0) run_row(&o, &presets[i], (int)k, &seq);
         if (want && (!o.method || strcmp(o.method, "cc") == 0)) run_cc_row(&o, &cc_presets[i], &seq);
         if (want && (!o.method || strcmp(o.method, "neupig") == 0)) run_neupig_row(&o, &presets[i], &neupig_presets[i], &seq);
+        if (want && (!o.method || strcmp(o.method, "pdg") == 0)) run_pdg_row(&o, &presets[i], &seq);
     }
     tcb_sequence_free(&seq);
     return 0;

@@ -51,7 +51,7 @@ def problem(path, frames, points):
     fn = torch.linalg.cross(b - a, c - a)  # twice the area times the unit normal
     N = torch.zeros_like(V).index_add_(0, Fc.reshape(-1), fn.repeat_interleave(3, 0))
     N = N / N.norm(dim=-1, keepdim=True).clamp_min(1e-12)
-    E = torch.cat([Fc[:, [0, 1]], Fc[:, [1, 2]], Fc[:, [2, 0]]]).sort(1).values.unique(dim=0)
+    E = torch_peer.edges(Fc)
     area = fn.norm(dim=-1)
     P = []
     for t in range(frames):

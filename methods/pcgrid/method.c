@@ -312,6 +312,13 @@ int tcb_pcgrid_train_steps(void *self, const tcb_sequence *seq, const tcb_fit_ct
     return rc;
 }
 
+const tcb_pcgrid_inputs *tcb_pcgrid_steps_inputs(const void *self, const void **trainer)
+{
+    const tcb_pcgrid_method *b = self;
+    if (trainer) *trainer = b->steps ? b->steps->t.state : NULL;
+    return b->steps ? &b->steps->in : NULL;
+}
+
 /* tcb_method_ops.run_unit: "template", the inputs and template mesh a fit
  * (and a load) builds before its first epoch: the clouds, the keyframe,
  * its template and the method's problem. Built aside, so that a training

@@ -101,6 +101,12 @@ int tcb_pcgrid_load(void *self, const tcb_sequence *seq, const char *path, tcb_e
 void tcb_pcgrid_destroy(void *self);
 int tcb_pcgrid_train_steps(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, long long n,
                            tcb_error *err);
+/* train_steps' training once the first call started it, else NULL: the
+ * inputs it trains on (every frame's cloud in the cube, the keyframe, the
+ * template as it started, the method's problem) and, unless trainer is
+ * NULL, its trainer's state (hooks->trainer_size bytes, the method's).
+ * For bench_train_step, which hands a PyTorch peer the same data. */
+const tcb_pcgrid_inputs *tcb_pcgrid_steps_inputs(const void *self, const void **trainer);
 int tcb_pcgrid_run_unit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, int unit, tcb_error *err);
 const char *tcb_pcgrid_normals_used(void *self, const tcb_sequence *seq);
 extern const char *const tcb_pcgrid_units[]; /* {"template", NULL} */

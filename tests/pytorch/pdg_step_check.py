@@ -14,6 +14,7 @@ import sys
 import numpy as np
 import torch
 
+import neupig_torch as nt
 import pdg_torch as pt
 
 torch.set_default_dtype(torch.float64)
@@ -34,7 +35,6 @@ verts = 0.5 * unit + 0.03 * rng.standard_normal(unit.shape)
 points = [0.5 * unit[rng.integers(0, 12, 30)] * (1 + 0.08 * (t - KEY)) + 0.05 * rng.standard_normal((30, 3))
           for t in range(N)]
 r = [1 + 2 * l for l in range(LEVELS)]
-lambdas = [LAMBDA * GROWTH ** l for l in range(LEVELS)]
 U = [0.8 * rng.standard_normal((N - 1, k ** 3, 3)) for k in r]
 L_tpl, edges = pt.uniform_laplacian(faces, len(verts))
 M_tpl = torch.eye(len(verts)) + TEMPLATE_LAMBDA * L_tpl
@@ -57,10 +57,9 @@ for k in r:
     U_t.append(torch.tensor(params[off:off + n].reshape(N - 1, k ** 3, 3), dtype=torch.float64, requires_grad=True))
     off += n
 u_t = torch.tensor(params[off:].reshape(-1, 3), dtype=torch.float64, requires_grad=True)
-v = torch.linalg.solve(M_tpl, u_t)
-template = pt.robust_chamfer(v, P[KEY])
-total, L_in, pred, edge = pt.objective(pt.field_values(U_t, lambdas), v, P, KEY, torch.tensor(edges), EPOCH, EPOCHS,
-                                       WARMUP)
+total, L_in, pred, edge, template = pt.step_loss(U_t, u_t, P, KEY, torch.tensor(edges), EPOCH, EPOCHS, WARMUP,
+                                                 pt.field_solvers(LEVELS, nt.dense_solver, LAMBDA, GROWTH),
+                                                 lambda u: torch.linalg.solve(M_tpl, u))
 (total + template).backward()
 ref_loss = np.array([total.item(), L_in.item(), pred.item(), edge.item(), template.item()])
 rel = np.abs(c_loss - ref_loss) / np.abs(ref_loss)

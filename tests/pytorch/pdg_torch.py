@@ -15,6 +15,11 @@ the robust Chamfer (sums, Welsch weight of the squared distance, detached);
 the input term, the chains from the detached template sampled at the moved
 points, the catch-up weights (detached), 250 x the edge-length L1 between
 consecutive steps.
+
+The solves and the nearest-neighbour search are passed in (`step_loss`):
+the check's dense ones on small grids (nt.dense_solver, a dense template
+matrix, `nearest_dense`), or bench/train_step_pdg_torch.py's at the
+presets' sizes (nt.basis_solver, a sparse factorisation, a GEMM search).
 """
 import torch
 import torch.nn.functional as F
@@ -22,18 +27,15 @@ import torch.nn.functional as F
 import neupig_torch as nt
 
 
-def field_values(U_levels, lambdas):
-    """V per level [T][r^3][3] from U per level (level 0, one node: M = I)."""
-    out = []
-    for U, lam in zip(U_levels, lambdas):
-        n = U.shape[1]
-        r = round(n ** (1 / 3))
-        if r == 1:
-            out.append(U)
-            continue
-        M = torch.eye(n) + lam * nt.laplacian(r)
-        out.append(torch.stack([torch.linalg.solve(M, U[g]) for g in range(U.shape[0])]))
-    return out
+def field_solvers(levels, make, lam=0.25, growth=1.5):
+    """Per level l (r = 1 + 2l nodes a side, lambda_l = lam growth^l): U
+    [T][r^3][3] -> V = M^-1 U, every transition's values the columns of one
+    solve make(r, lambda_l) (nt.dense_solver or nt.basis_solver; level 0,
+    one node, has L = 0: M = I)."""
+    def level(r, solve):
+        return lambda U: solve(U.transpose(0, 1).reshape(r ** 3, -1)).reshape(r ** 3, -1, 3).transpose(0, 1)
+
+    return [level(1 + 2 * l, make(1 + 2 * l, lam * growth ** l)) for l in range(levels)]
 
 
 def uniform_laplacian(faces, nv):
@@ -59,9 +61,14 @@ def move(V_levels, g, x):
     return x + 0.1 * torch.tanh(s)
 
 
-def robust_chamfer(X, P, alpha=0.3):
+def nearest_dense(X, P):
+    """Squared distances to the nearest point of the other cloud, both ways."""
     d2 = torch.cdist(X, P) ** 2
-    sx, sp = d2.min(dim=1).values, d2.min(dim=0).values
+    return d2.min(dim=1).values, d2.min(dim=0).values
+
+
+def robust_chamfer(X, P, nearest=nearest_dense, alpha=0.3):
+    sx, sp = nearest(X, P)
     w = lambda s: torch.exp(-s * s / (2 * alpha * alpha)).detach()
     return (w(sx) * sx).sum() + (w(sp) * sp).sum()
 
@@ -71,11 +78,11 @@ def edge_l1(x, prev, edges):
     return (torch.linalg.norm(x[a] - x[b], dim=1) - torch.linalg.norm(prev[a] - prev[b], dim=1)).abs().mean()
 
 
-def objective(V_levels, v, P, key, edges, epoch, epochs, warmup, edge_w=250.0):
+def objective(V_levels, v, P, key, edges, epoch, epochs, warmup, nearest=nearest_dense, edge_w=250.0):
     """(total, input, pred, edge) of one epoch; v the template (detached here)."""
     n = len(P)
     T = n - 1
-    L_in = sum(robust_chamfer(move(V_levels, g, P[g + 1 if g < key else g]), P[g if g < key else g + 1])
+    L_in = sum(robust_chamfer(move(V_levels, g, P[g + 1 if g < key else g]), P[g if g < key else g + 1], nearest)
                for g in range(T)) / T
     zero = torch.zeros(())
     if epoch < warmup:
@@ -93,7 +100,7 @@ def objective(V_levels, v, P, key, edges, epoch, epochs, warmup, edge_w=250.0):
         for k in live:
             g, t = (key - m, key - m) if k == 0 else (key + m - 1, key + m)
             nx = move(V_levels, g, x[k])
-            CD = CD + robust_chamfer(nx, P[t]) / len(live)
+            CD = CD + robust_chamfer(nx, P[t], nearest) / len(live)
             E = E + edge_l1(nx, x[k], edges) / len(live)
             x[k] = nx
         c = s ** e
@@ -102,3 +109,15 @@ def objective(V_levels, v, P, key, edges, epoch, epochs, warmup, edge_w=250.0):
         S += c * CD.item()
         s /= max(1.0, 1.0 + S - L_in.item())
     return L_in + pred + edge, L_in, pred, edge
+
+
+def step_loss(U_levels, u, P, key, edges, epoch, epochs, warmup, field_solve, template_solve, nearest=nearest_dense):
+    """One training step's loss parts of the fields' U (per level) and the
+    template's Large-Steps u: (total, input, pred, edge) of the objective
+    and the template's robust Chamfer to the keyframe's points; the step
+    minimises total + template. field_solve: field_solvers' per level;
+    template_solve: v = (I + 16 L)^-1 u."""
+    V = [solve(U) for solve, U in zip(field_solve, U_levels)]
+    v = template_solve(u)
+    template = robust_chamfer(v, P[key], nearest)
+    return objective(V, v, P, key, edges, epoch, epochs, warmup, nearest) + (template,)
