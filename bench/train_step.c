@@ -54,10 +54,10 @@
  * Steps solve, backward, Adam) at the paper preset (10 levels, 5 000
  * points a frame, a template of up to 20 000 triangles) and the cpu
  * preset's (10 levels, 2 500 points, up to 10 000 triangles), on the
- * calibration sequence's 6 frames. Created with {"preset": P, "warmup":
- * 0}, so that every timed epoch has every term: the 101 warm-up epochs
- * (the input term alone) are 2 % of a paper fit and 10 % of a cpu one,
- * and what `tcbench calibrate` times. The peer train_step_pdg_torch.py
+ * calibration sequence's 6 frames. Its train_steps, as `tcbench
+ * calibrate`'s, times the main phase: every term from the first epoch
+ * (the 101 warm-up epochs, the input term alone, are 2 % of a paper fit
+ * and 5 % of a cpu one). The peer train_step_pdg_torch.py
  * (tests/pytorch/pdg_torch.py's reference loss, float32, torch.optim.Adam
  * with the per-level rates) trains on the C training's own data, written
  * to a temporary directory: every frame's cloud in the fields' cube, the
@@ -144,11 +144,11 @@ typedef struct {
 
 #define die(...) bench_die("bench_train_step", __VA_ARGS__)
 
-/* Method `name` created with {"preset": preset<more>}; *ops its table. */
-static void *create_at(const char *name, const char *preset, const char *more, const tcb_method_ops **ops)
+/* Method `name` created with {"preset": preset}; *ops its table. */
+static void *create_at(const char *name, const char *preset, const tcb_method_ops **ops)
 {
     char params[128];
-    snprintf(params, sizeof params, "{\"preset\": \"%s\"%s}", preset, more);
+    snprintf(params, sizeof params, "{\"preset\": \"%s\"}", preset);
     tcb_error err = {0};
     void *self;
     *ops = tcb_registry_find(name);
@@ -173,7 +173,7 @@ static double time_steps(const tcb_method_ops *ops, void *self, const tcb_sequen
 static double time_c(const char *name, const char *preset, const tcb_sequence *seq, const options *o)
 {
     const tcb_method_ops *ops;
-    void *self = create_at(name, preset, "", &ops);
+    void *self = create_at(name, preset, &ops);
     double ms = time_steps(ops, self, seq, o);
     ops->destroy(self);
     return ms;
@@ -358,7 +358,7 @@ static void run_neupig_row(options *o, const preset *p, const neupig_preset *pr,
     if (!mkdtemp(dir)) die("cannot create a temporary directory in /tmp");
     snprintf(obj, sizeof obj, "%s/template.obj", dir);
     const tcb_method_ops *ops;
-    void *self = create_at("neupig", p->name, "", &ops);
+    void *self = create_at("neupig", p->name, &ops);
     double tms = 0, ms = time_steps(ops, self, seq, o);
     int nv = write_surface(ops, self, seq, obj);
     ops->destroy(self);
@@ -391,7 +391,7 @@ static void print_losses(const tcb_method_ops *ops, void *self, const tcb_sequen
 static void run_pdg_row(options *o, const preset *p, const tcb_sequence *seq)
 {
     const tcb_method_ops *ops;
-    void *self = create_at("pdg", p->name, ", \"warmup\": 0", &ops);
+    void *self = create_at("pdg", p->name, &ops);
     if (o->losses) print_losses(ops, self, seq, o);
     double tms = 0, ms = time_steps(ops, self, seq, o);
     char dir[] = "/tmp/bench_train_step_XXXXXX", cmd[8192];

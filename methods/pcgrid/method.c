@@ -289,7 +289,7 @@ int tcb_pcgrid_load(void *self, const tcb_sequence *seq, const char *path, tcb_e
 /* ---- calibration ---- */
 
 /* tcb_method_ops.train_steps: fit's training (its inputs and template
- * built by the first call) n epochs at a time; the fitted model follows
+ * built by the first call; in its main phase) n epochs at a time; the fitted model follows
  * from the epochs done when a read-out first asks (steps_model), so that
  * the timed calls are epochs only. */
 int tcb_pcgrid_train_steps(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, long long n, tcb_error *err)
@@ -303,6 +303,7 @@ int tcb_pcgrid_train_steps(void *self, const tcb_sequence *seq, const tcb_fit_ct
             return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", b->hooks->name);
         rc = prepare(b, seq, ctx->seed, &b->fitted, &b->steps->in, err);
         if (!rc) rc = trainer_init(b, &b->steps->in, ctx->seed, &b->steps->t, err);
+        if (!rc && b->hooks->main_phase) b->hooks->main_phase(b->steps->t.state);
         if (rc) steps_free(b);
     }
     double loss;

@@ -60,6 +60,10 @@ typedef struct tcb_pcgrid_hooks {
     int (*frames)(void *trainer, float *X, tcb_error *err);
     /* The sizes the model file's parameters were fitted with. */
     cJSON *(*manifest)(const void *self, size_t n_params);
+    /* Optional (NULL: none). Puts a fresh trainer of train_steps into the
+     * phase that dominates a fit (tcb/method.h, train_steps): PDG's first
+     * 101 epochs train the input term alone, cheaper than the rest. */
+    void (*main_phase)(void *trainer);
 } tcb_pcgrid_hooks;
 
 enum { TCB_PCGRID_NORMALS_ESTIMATED, TCB_PCGRID_NORMALS_GT, TCB_PCGRID_NORMALS_INPUT };
