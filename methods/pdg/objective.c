@@ -16,8 +16,10 @@ static int dst_frame(int g, int key) { return g < key ? g : g + 1; }
 typedef struct chain {
     int dir, len;
     float *x;    /* [len + 1][nv][3]: x⁰ = v, …, x^len */
-    float *s;    /* [len][nv][3]: each step's level mean, for the backward */
+    float *s;    /* [len][nv][C]: each step's level mean, for the backward */
     float *grad; /* [len + 1][nv][3]: ∂loss/∂x^m */
+    float *A;    /* cayley: [len][nv][12] A^1 … A^len (x^m = A^m v; A⁰ = I); else NULL */
+    float *gA;   /* cayley: [len][nv][12] ∂loss/∂A^m from the steps after m; else NULL */
 } chain;
 
 static int field_of(int key, int dir, int m) { return dir < 0 ? key - m : key + m - 1; }
@@ -25,45 +27,67 @@ static int frame_of(int key, int dir, int m) { return dir < 0 ? key - m : key + 
 
 static void chains_free(chain c[2])
 {
-    for (int k = 0; k < 2; k++) free(c[k].x), free(c[k].s), free(c[k].grad);
+    for (int k = 0; k < 2; k++) free(c[k].x), free(c[k].s), free(c[k].grad), free(c[k].A), free(c[k].gA);
     memset(c, 0, 2 * sizeof *c);
 }
 
-/* Both chains run forward from v, their gradients zeroed. */
-static int chains_run(const tcb_pdg_fields *f, const float *V, const tcb_pdg_problem *p, chain c[2], tcb_error *err)
+/* Step m's carry into *buf (NULL when released: the chain's points are all
+ * a translation carries). */
+static const tcb_pdg_carry *carry_at(const tcb_pdg_fields *f, const tcb_pdg_problem *p, const chain *c, int m,
+                                     tcb_pdg_carry *buf)
+{
+    if (f->rotation == TCB_PDG_RELEASED) return NULL;
+    size_t at = (size_t)p->nv * TCB_PDG_AFFINE;
+    *buf = (tcb_pdg_carry){.x0 = p->template_verts,
+                           .A = m > 1 ? c->A + (m - 2) * at : NULL,
+                           .A_out = c->A + (m - 1) * at,
+                           .dA_out = c->gA && m < c->len ? c->gA + (m - 1) * at : NULL,
+                           .dA = c->gA && m > 1 ? c->gA + (m - 2) * at : NULL};
+    return buf;
+}
+
+/* Both chains run forward from v, their gradients zeroed (none kept
+ * without grads: the read-out). */
+static int chains_run(const tcb_pdg_fields *f, const float *V, const tcb_pdg_problem *p, int grads, chain c[2],
+                      tcb_error *err)
 {
     memset(c, 0, 2 * sizeof *c);
-    size_t frame = (size_t)p->nv * 3;
+    size_t frame = (size_t)p->nv * 3, na = f->rotation == TCB_PDG_CAYLEY ? (size_t)p->nv * TCB_PDG_AFFINE : 0;
     for (int k = 0; k < 2; k++) {
         c[k].dir = k ? 1 : -1;
         c[k].len = k ? p->n - 1 - p->key : p->key;
+        size_t steps = (size_t)(c[k].len ? c[k].len : 1);
         c[k].x = malloc((size_t)(c[k].len + 1) * frame * sizeof *c[k].x);
-        c[k].s = malloc((size_t)(c[k].len ? c[k].len : 1) * frame * sizeof *c[k].s);
-        c[k].grad = calloc((size_t)(c[k].len + 1) * frame, sizeof *c[k].grad);
-        if (!c[k].x || !c[k].s || !c[k].grad) {
+        c[k].s = malloc(steps * p->nv * f->C * sizeof *c[k].s);
+        c[k].grad = grads ? calloc((size_t)(c[k].len + 1) * frame, sizeof *c[k].grad) : NULL;
+        c[k].A = na ? malloc(steps * na * sizeof *c[k].A) : NULL;
+        c[k].gA = na && grads ? calloc(steps * na, sizeof *c[k].gA) : NULL;
+        if (!c[k].x || !c[k].s || (grads && !c[k].grad) || (na && !c[k].A) || (na && grads && !c[k].gA)) {
             chains_free(c);
             return tcb_fail(err, TCB_ERR_NOMEM, "pdg: out of memory for the chains");
         }
         memcpy(c[k].x, p->template_verts, frame * sizeof *c[k].x);
-        for (int m = 1; m <= c[k].len; m++)
+        for (int m = 1; m <= c[k].len; m++) {
+            tcb_pdg_carry buf;
             tcb_pdg_field_forward(f, V, field_of(p->key, c[k].dir, m), c[k].x + (m - 1) * frame, p->nv,
-                                  c[k].s + (m - 1) * frame, c[k].x + m * frame);
+                                  carry_at(f, p, &c[k], m, &buf), c[k].s + (size_t)(m - 1) * p->nv * f->C,
+                                  c[k].x + m * frame);
+        }
     }
     return TCB_OK;
 }
 
-void tcb_pdg_propagate(const tcb_pdg_fields *f, const float *V, const tcb_pdg_problem *p, float *X)
+int tcb_pdg_propagate(const tcb_pdg_fields *f, const float *V, const tcb_pdg_problem *p, float *X, tcb_error *err)
 {
+    chain c[2];
+    int rc = chains_run(f, V, p, 0, c, err);
+    if (rc) return rc;
     size_t frame = (size_t)p->nv * 3;
-    memcpy(X + (size_t)p->key * frame, p->template_verts, frame * sizeof *X);
-    float *s = malloc(frame * sizeof *s);
-    for (int dir = -1; s && dir <= 1; dir += 2) {
-        int len = dir > 0 ? p->n - 1 - p->key : p->key;
-        for (int m = 1; m <= len; m++)
-            tcb_pdg_field_forward(f, V, field_of(p->key, dir, m), X + (size_t)frame_of(p->key, dir, m - 1) * frame,
-                                  p->nv, s, X + (size_t)frame_of(p->key, dir, m) * frame);
-    }
-    free(s);
+    for (int k = 0; k < 2; k++)
+        for (int m = k; m <= c[k].len; m++) /* the keyframe once: v */
+            memcpy(X + (size_t)frame_of(p->key, c[k].dir, m) * frame, c[k].x + m * frame, frame * sizeof *X);
+    chains_free(c);
+    return TCB_OK;
 }
 
 /* L_in and its gradient into dV. */
@@ -72,19 +96,19 @@ static int input_term(const tcb_pdg_fields *f, const float *V, const tcb_pdg_pro
 {
     int T = p->n - 1, most = 0;
     for (int t = 0; t < p->n; t++) most = p->n_points[t] > most ? p->n_points[t] : most;
-    float *y = malloc((size_t)most * 3 * sizeof *y), *s = malloc((size_t)most * 3 * sizeof *s),
-          *dy = malloc((size_t)most * 3 * sizeof *dy), *ds = malloc((size_t)most * 3 * sizeof *ds);
+    float *y = malloc((size_t)most * 3 * sizeof *y), *s = malloc((size_t)most * f->C * sizeof *s),
+          *dy = malloc((size_t)most * 3 * sizeof *dy), *ds = malloc((size_t)most * f->C * sizeof *ds);
     int rc = y && s && dy && ds ? TCB_OK : tcb_fail(err, TCB_ERR_NOMEM, "pdg: out of memory");
     *L = 0.0;
     for (int g = 0; !rc && g < T; g++) {
         int a = src_frame(g, p->key), b = dst_frame(g, p->key), n = p->n_points[a];
-        tcb_pdg_field_forward(f, V, g, p->points[a], n, s, y);
+        tcb_pdg_field_forward(f, V, g, p->points[a], n, NULL, s, y);
         double cd;
         rc = tcb_robust_chamfer(y, n, p->points[b], p->n_points[b], p->points_index[b], w->alpha, &cd, dy, err);
         if (rc) break;
         *L += cd / T;
         for (size_t i = 0; i < (size_t)n * 3; i++) dy[i] /= (float)T;
-        tcb_pdg_field_backward(f, V, g, p->points[a], n, s, dy, dV, NULL, ds);
+        tcb_pdg_field_backward(f, V, g, p->points[a], n, NULL, s, dy, dV, NULL, ds);
     }
     free(y), free(s), free(dy), free(ds);
     return rc;
@@ -170,16 +194,18 @@ int tcb_pdg_loss_grad(const tcb_pdg_fields *f, const float *V, const tcb_pdg_pro
     out->total = out->input;
     if (rc || epoch < w->warmup) return rc;
     chain c[2];
-    if ((rc = chains_run(f, V, p, c, err))) return rc;
+    if ((rc = chains_run(f, V, p, 1, c, err))) return rc;
     rc = chain_terms(p, w, epoch, epochs, out->input, c, out, err);
-    size_t frame = (size_t)p->nv * 3;
-    float *ds = rc ? NULL : malloc(frame * sizeof *ds);
+    size_t frame = (size_t)p->nv * 3, each = (size_t)p->nv * f->C;
+    float *ds = rc ? NULL : malloc(each * sizeof *ds);
     if (!rc && !ds) rc = tcb_fail(err, TCB_ERR_NOMEM, "pdg: out of memory");
     for (int k = 0; !rc && k < 2; k++) /* back along each chain; x⁰ = v is held constant */
-        for (int m = c[k].len; m >= 1; m--)
+        for (int m = c[k].len; m >= 1; m--) {
+            tcb_pdg_carry buf;
             tcb_pdg_field_backward(f, V, field_of(p->key, c[k].dir, m), c[k].x + (m - 1) * frame, p->nv,
-                                   c[k].s + (m - 1) * frame, c[k].grad + m * frame, dV,
+                                   carry_at(f, p, &c[k], m, &buf), c[k].s + (m - 1) * each, c[k].grad + m * frame, dV,
                                    m > 1 ? c[k].grad + (m - 1) * frame : NULL, ds);
+        }
     free(ds);
     chains_free(c);
     out->total = out->input + out->pred + out->edge;

@@ -8,7 +8,9 @@
  *
  *   input term   L_in = (1/T) Σ_g RC(field_g(P_src(g)), P_dst(g))
  *   the chain    from the template v (held constant) outward both ways:
- *                x⁰ = v, x^m = field_{g_m}(x^{m−1}), the backward chain
+ *                x⁰ = v, x^m = field_{g_m}(x^{m−1}) (with the cayley
+ *                rotation x^m = A^m v, A^m = A^{m−1}·[R_m | t_m] sampled
+ *                at x^{m−1}: methods/pdg/field.h), the backward chain
  *                through fields K−1, K−2, … onto frames K−1, K−2, …, the
  *                forward chain through fields K, K+1, … onto frames K+1, …;
  *                each field is sampled where the previous ones moved the
@@ -62,6 +64,6 @@ int tcb_pdg_loss_grad(const tcb_pdg_fields *f, const float *V, const tcb_pdg_pro
 
 /* X [n][nv][3]: the template carried into every frame by the chains
  * (X[K] = v): the fitted meshes. */
-void tcb_pdg_propagate(const tcb_pdg_fields *f, const float *V, const tcb_pdg_problem *p, float *X);
+int tcb_pdg_propagate(const tcb_pdg_fields *f, const float *V, const tcb_pdg_problem *p, float *X, tcb_error *err);
 
 #endif

@@ -1,7 +1,7 @@
 /* pdg: Preconditioned Deformation Grids (PDG, Computer Graphics Forum
  * 2025): one template, the keyframe's screened Poisson surface remeshed
  * and decimated (methods/pcgrid/template.h), carried outward from the
- * keyframe through one translation field per frame transition, each a
+ * keyframe through one deformation field per frame transition, each a
  * mean of preconditioned lattice levels (methods/pdg/field.h), the
  * template itself evolving under Large Steps; optimised per sequence on
  * the frames' point clouds (methods/pdg/train.h). docs/protocol.md, "PDG",
@@ -15,6 +15,12 @@
  *                 for the Poisson surface, as neupig's
  *   keyframe_res  the keyframe rule's lattice (128, the release's default;
  *                 its AMA script passes 512)
+ *   rotation      released (default): translations alone, as the release
+ *                 deforms (its rotation never leaves the identity), 3
+ *                 values a node | cayley: the proper Cayley rotation
+ *                 composed as the release composes its transforms, 6
+ *                 values a node (methods/pdg/field.h); the model file and
+ *                 the checkpoints of one are refused by the other
  *   epochs, warmup, points, template_faces (default min(20 000, 4·points)),
  *   poisson_depth, levels, recon_points, checkpoint_every, divergence
  *
@@ -68,12 +74,13 @@ static int parse(const char *params_json, void *obj, tcb_error *err)
     tcb_pcgrid_method *b = &m->base;
     static const char *const keys[] = {"preset",         "normals",     "keyframe_res", "epochs",
                                        "warmup",         "points",      "template_faces", "poisson_depth",
-                                       "levels",         "recon_points", "checkpoint_every", "divergence", NULL};
+                                       "levels",         "recon_points", "checkpoint_every", "divergence",
+                                       "rotation",       NULL};
     const char *where = "pdg.params";
     cJSON *j;
     int rc = tcb_params_parse(params_json, where, keys, &j, err);
     if (rc) return rc;
-    int pi = 1;
+    int pi = 1, rotation = TCB_PDG_RELEASED;
     long long epochs, warmup, points = 0, faces, depth, levels, kres;
     rc = tcb_json_enum(j, "preset", where, 0, 1, preset_names, &pi, err);
     if (!rc) rc = tcb_pcgrid_parse_common(j, where, b, err);
@@ -87,10 +94,12 @@ static int parse(const char *params_json, void *obj, tcb_error *err)
     if (!rc) rc = tcb_json_int(j, "levels", where, 0, p->levels, 1, TCB_PDG_MAX_LEVELS, &levels, err);
     if (!rc) rc = tcb_json_int(j, "keyframe_res", where, 0, 128, 1, 4096, &kres, err);
     if (!rc) rc = tcb_json_num(j, "divergence", where, 0, 1e4, 0, 1e300, &m->sched.divergence, err);
+    if (!rc) rc = tcb_json_enum(j, "rotation", where, 0, TCB_PDG_RELEASED, tcb_pdg_rotation_names, &rotation, err);
     cJSON_Delete(j);
     if (rc) return rc;
     m->arch = tcb_pdg_arch_reference();
     m->arch.levels = (int)levels;
+    m->arch.rotation = (tcb_pdg_rotation)rotation;
     m->sched.epochs = epochs, m->sched.warmup = warmup;
     m->sched.lr_grid = 0.005, m->sched.lr_growth = 1.1, m->sched.lr_template = 1e-4;
     b->hooks = &hooks, b->fitted.method = "pdg";
@@ -168,6 +177,7 @@ static cJSON *manifest(const void *self, size_t n_params)
     const char *const names[] = {"levels", "points", "template_faces", "poisson_depth", "keyframe_res",
                                  "gt_normals"};
     for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) cJSON_AddNumberToObject(j, names[k], sizes[k]);
+    cJSON_AddStringToObject(j, "rotation", tcb_pdg_rotation_names[m->arch.rotation]);
     cJSON_AddNumberToObject(j, "parameters", (double)n_params);
     return j;
 }
@@ -183,8 +193,9 @@ static const tcb_pcgrid_hooks hooks = {
 
 /* ---- the dry run's estimate ---- */
 
-/* The calibrated preset of m's sizes (every preset is calibrated); -1 when
- * one differs from each. */
+/* The calibrated preset of m's sizes (every preset is calibrated, with the
+ * released rotation); -1 when one differs from each, or with the cayley
+ * rotation (twice the values a node: its epochs cost more). */
 static int calibrated_preset(const pdg_method *m)
 {
     const tcb_pcgrid_method *b = &m->base;
@@ -192,7 +203,7 @@ static int calibrated_preset(const pdg_method *m)
         const pdg_preset *p = &presets[k];
         if (b->points == p->points && b->spec.template_faces == template_budget(p->points) &&
             b->spec.poisson_depth == p->poisson_depth && m->arch.levels == p->levels &&
-            b->recon_points == TCB_PCGRID_RECON_POINTS)
+            b->recon_points == TCB_PCGRID_RECON_POINTS && m->arch.rotation == TCB_PDG_RELEASED)
             return k;
     }
     return -1;
@@ -208,7 +219,8 @@ const tcb_method_ops tcb_method_pdg = {
     .abi_version = TCB_METHOD_ABI_VERSION,
     .name = "pdg",
     .description = "PDG (CGF 2025): a remeshed Poisson template of the keyframe carried frame to frame by "
-                   "preconditioned translation grids, the template evolving under Large Steps; barycentric read-out",
+                   "preconditioned translation grids (or translation and Cayley rotation), the template evolving "
+                   "under Large Steps; barycentric read-out",
     .create = create,
     .estimate = estimate,
     .presets = preset_names,

@@ -9,7 +9,10 @@
 #include "neural/train_ckpt.h"
 #include "neural/train_loop.h"
 
-tcb_pdg_arch tcb_pdg_arch_reference(void) { return (tcb_pdg_arch){10, 0.25, 1.5, 16.0, 250.0, 0.3}; }
+tcb_pdg_arch tcb_pdg_arch_reference(void)
+{
+    return (tcb_pdg_arch){10, TCB_PDG_RELEASED, 0.25, 1.5, 16.0, 250.0, 0.3};
+}
 
 static size_t n_fields(const tcb_pdg_trainer *t) { return t->fields.off[t->fields.levels]; }
 
@@ -23,7 +26,7 @@ int tcb_pdg_trainer_init(tcb_pdg_trainer *t, const tcb_pdg_arch *a, const tcb_pd
                         s->epochs, s->warmup, s->lr_grid, s->lr_growth, s->lr_template);
     t->arch = *a, t->sched = *s, t->data = d;
     const tcb_mesh *m = d->template_mesh;
-    int rc = tcb_pdg_fields_init(&t->fields, a->levels, d->n - 1, a->lambda, a->lambda_growth, err);
+    int rc = tcb_pdg_fields_init(&t->fields, a->levels, d->n - 1, a->rotation, a->lambda, a->lambda_growth, err);
     if (!rc) rc = tcb_large_steps_init(&t->template_ls, m->n_verts, m->faces, m->n_faces, a->template_lambda, err);
     if (rc) {
         tcb_pdg_trainer_free(t);
@@ -122,12 +125,11 @@ int tcb_pdg_trainer_frames(tcb_pdg_trainer *t, float *X, tcb_error *err)
     if (rc) return rc;
     tcb_pdg_fields_solve(&t->fields, t->params, t->values, t->scratch);
     const tcb_pdg_problem p = problem_of(t);
-    tcb_pdg_propagate(&t->fields, t->values, &p, X);
-    return TCB_OK;
+    return tcb_pdg_propagate(&t->fields, t->values, &p, X, err);
 }
 
-static const char *const int_names[] = {"levels", "frames", "keyframe", "template vertices", "template faces",
-                                        "epochs", "warm-up"};
+static const char *const int_names[] = {"levels", "rotation", "frames", "keyframe", "template vertices",
+                                        "template faces", "epochs", "warm-up"};
 static const char *const real_names[] = {"lambda", "lambda_growth", "template_lambda", "edge_weight",
                                          "alpha", "lr_grid", "lr_growth", "lr_template"};
 
@@ -138,9 +140,10 @@ static tcb_ckpt_spec spec_of(tcb_pdg_trainer *t, uint64_t seed)
     const tcb_pdg_schedule *s = &t->sched;
     const tcb_pdg_data *d = t->data;
     return (tcb_ckpt_spec){
-        .magic = "TCBPDG01", .what = "a PDG training checkpoint",
-        .n_ints = 7, .n_reals = 8, .n_arrays = 3, .int_names = int_names, .real_names = real_names,
-        .ints = {a->levels, d->n, d->key, d->template_mesh->n_verts, d->template_mesh->n_faces, s->epochs, s->warmup},
+        .magic = "TCBPDG02", .what = "a PDG training checkpoint", /* 02: the rotation among the settings */
+        .n_ints = 8, .n_reals = 8, .n_arrays = 3, .int_names = int_names, .real_names = real_names,
+        .ints = {a->levels, a->rotation, d->n, d->key, d->template_mesh->n_verts, d->template_mesh->n_faces, s->epochs,
+                 s->warmup},
         .reals = {a->lambda, a->lambda_growth, a->template_lambda, a->edge_weight, a->alpha, s->lr_grid, s->lr_growth,
                   s->lr_template},
         .seed = seed, .max_it = s->epochs,

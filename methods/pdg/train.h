@@ -21,6 +21,7 @@
 
 typedef struct tcb_pdg_arch {
     int levels;                 /* 10 */
+    tcb_pdg_rotation rotation;  /* released (methods/pdg/field.h) */
     double lambda, lambda_growth; /* the fields' λ_l = 0.25·1.5^l */
     double template_lambda;     /* 16 */
     double edge_weight, alpha;  /* 250, 0.3 */
@@ -81,7 +82,8 @@ int tcb_pdg_train_step(tcb_pdg_trainer *t, double *loss, tcb_error *err);
  * frame (the fitted meshes). */
 int tcb_pdg_trainer_frames(tcb_pdg_trainer *t, float *X, tcb_error *err);
 
-/* The whole training state; a checkpoint of other settings is refused. */
+/* The whole training state; a checkpoint of other settings (the rotation
+ * among them) is refused. */
 int tcb_pdg_train_save(const tcb_pdg_trainer *t, uint64_t seed, double seconds, const char *path, tcb_error *err);
 int tcb_pdg_train_load(tcb_pdg_trainer *t, uint64_t seed, const char *path, double *seconds, tcb_error *err);
 

@@ -26,7 +26,8 @@ work=work/synth/quadruped_walk/pdg/seed_0
 
 "$TCBENCH" run pdg.json --out full --quiet
 ls full/$work/template_keyframe_*.obj > /dev/null || { echo "FAIL: no template written"; exit 1; }
-/usr/bin/python3 - full/$cell <<'PY'
+check_cell() {
+    /usr/bin/python3 - "$1" <<'PY'
 import json, math, sys
 c = json.load(open(sys.argv[1]))
 assert c["status"] == "ok", (c["status"], c["message"])
@@ -40,6 +41,8 @@ assert [r[0] for r in surf["rows"]] == frames, surf
 for key in ("cdl2", "nc", "fscore05", "fscore1"):
     assert s[key]["n"] == len(frames), (key, s[key])
 PY
+}
+check_cell full/$cell
 
 "$TCBENCH" inspect full pdg 0 --out insp > inspect.txt
 grep -q "agree: largest relative difference 0.0e+00" inspect.txt || { cat inspect.txt; exit 1; }
@@ -47,8 +50,19 @@ grep -q "agree: largest relative difference 0.0e+00" inspect.txt || { cat inspec
 kill_mid_fit pdg.json "$work" "$cell"
 same_cells full killed
 
+sed 's/"checkpoint_every": 4/"checkpoint_every": 4, "rotation": "cayley"/' pdg.json > cayley.json
+"$TCBENCH" run cayley.json --out cayley --quiet
+check_cell cayley/$cell
+# the cayley model under the released cell's record (its params made the
+# released ones): the model file's manifest refuses it
+cp -r full swapped
+cp cayley/$work/model.ckpt cayley/$work/model.ckpt.fit.json swapped/$work/
+sed -i 's/,\\"rotation\\":\\"cayley\\"//' swapped/$work/model.ckpt.fit.json
+expect 2 'model.ckpt.rotation: expected "released" for this model' "$TCBENCH" inspect swapped pdg 0 --out insp2
+
 bad() { sed "s/\"preset\": \"tiny\", \"checkpoint_every\": 4/$1/" pdg.json > bad.json; expect 2 "$2" "$TCBENCH" run bad.json --out bad --quiet; }
 bad '"preset": "huge"' "pdg.params.preset"
 bad '"preset": "tiny", "levels": 0' "pdg.params.levels"
 bad '"preset": "tiny", "layers": 3' "pdg.params.layers: unknown key"
+bad '"preset": "tiny", "rotation": "euler"' "pdg.params.rotation"
 echo "pdg test passed"

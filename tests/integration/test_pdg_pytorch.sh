@@ -4,7 +4,9 @@
 # (tests/pytorch/pdg_step_check.py), on a small random problem: three field
 # levels per transition solved densely, the input term, both chains from the
 # keyframe with their catch-up weights and edge term, the template's
-# Large-Steps parameters pulled to the keyframe.
+# Large-Steps parameters pulled to the keyframe; with each rotation
+# (released: translations alone; cayley: the Cayley rotation solved in
+# autograd as torch.linalg.solve(I - K, I + K)).
 # Skipped (77) when /usr/bin/python3 has no torch (Debian: python3-torch).
 set -euo pipefail
 : "${TCB_SOURCE_DIR:?}" "${TCB_BUILD_DIR:?}" "${CC:=cc}"

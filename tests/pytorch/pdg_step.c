@@ -1,17 +1,19 @@
 /* Test helper (not installed): one PDG training step's loss and gradients
  * (methods/pdg/train.c) on inputs written by tests/pytorch/pdg_step_check.py,
  * for comparison with its PyTorch autograd reference:
- *     pdg_step DIR LEVELS FRAMES KEY EPOCH EPOCHS WARMUP
- * reads DIR/verts.npy (float32 [nv][3], the template as it starts),
+ *     pdg_step DIR LEVELS FRAMES KEY EPOCH EPOCHS WARMUP ROTATION
+ * (ROTATION released or cayley: methods/pdg/field.h) reads DIR/verts.npy (float32 [nv][3], the template as it starts),
  * DIR/faces.npy (int32 [nf][3]), DIR/points_<t>.npy (float32 [n][3], in
- * the cube) and DIR/params.npy (float32: the fields' U, level-major, then
- * the template's u), sets the trainer's epoch and parameters, runs one
+ * the cube) and DIR/params.npy (float32: the fields' U, level-major
+ * [T][r³][C], then the template's u), sets the trainer's epoch and parameters, runs one
  * step and writes DIR/c_loss.npy (float64 [total, input, pred, edge,
  * template]) and DIR/c_grads.npy (float32, the parameters' layout: the
  * gradient the step's Adam took). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "methods/pdg/field.h"
 
 #include "methods/pdg/train.h"
 #include "tcb/npy.h"
@@ -41,8 +43,11 @@ static int save(const char *dir, const char *name, tcb_npy_dtype t, uint64_t n, 
 
 int main(int argc, char **argv)
 {
-    if (argc != 8) {
-        fprintf(stderr, "usage: pdg_step DIR LEVELS FRAMES KEY EPOCH EPOCHS WARMUP\n");
+    int rotation = 0;
+    while (argc == 9 && tcb_pdg_rotation_names[rotation] && strcmp(argv[8], tcb_pdg_rotation_names[rotation]))
+        rotation++;
+    if (argc != 9 || !tcb_pdg_rotation_names[rotation]) {
+        fprintf(stderr, "usage: pdg_step DIR LEVELS FRAMES KEY EPOCH EPOCHS WARMUP released|cayley\n");
         return 2;
     }
     const char *dir = argv[1];
@@ -68,7 +73,7 @@ int main(int argc, char **argv)
     tcb_mesh tmpl = {(int)(nv3 / 3), (int)(nf3 / 3), verts, faces};
     tcb_pdg_data data = {n, key, (const float *const *)pts, n_pts, (const tcb_nn *const *)idx, &tmpl};
     tcb_pdg_arch a = tcb_pdg_arch_reference();
-    a.levels = levels;
+    a.levels = levels, a.rotation = (tcb_pdg_rotation)rotation;
     tcb_pdg_schedule s = {epochs, warmup, 0.005, 1.1, 1e-4, 0.0};
     tcb_pdg_trainer tr;
     if (tcb_pdg_trainer_init(&tr, &a, &s, &data, &err)) goto fail;

@@ -9,8 +9,14 @@ Every operation is the reference's: per transition and level, the values
 V = M^-1 U with M = I + lambda_l L (pcgrid's lattice Laplacian, its
 diagonal the occurrences in a both-way edge list: neupig_torch.laplacian);
 grid_sample with align_corners=True and border padding, the level mean,
-the translation 0.1 tanh (the release's rotation never leaves zero); the
-template v = (I + 16 L)^-1 u with L the uniform Laplacian of its edges;
+the translation 0.1 tanh; the rotation the identity ("released": the
+release's never leaves it) or the Cayley map of the first 3 channels,
+R = (I - K)^-1 (I + K) by torch.linalg.solve ("cayley"); each step the
+affine [R | t] composed as the release composes its 4x4 transforms
+(src/optimization.py:135-143: A <- A [R | t], x = A x0 with x0 the
+template), the input term's step applied to the frame's own points
+(y = R x + t); the template v = (I + 16 L)^-1 u with L the uniform
+Laplacian of its edges;
 the robust Chamfer (sums, Welsch weight of the squared distance, detached);
 the input term, the chains from the detached template sampled at the moved
 points, the catch-up weights (detached), 250 x the edge-length L1 between
@@ -29,11 +35,12 @@ import neupig_torch as nt
 
 def field_solvers(levels, make, lam=0.25, growth=1.5):
     """Per level l (r = 1 + 2l nodes a side, lambda_l = lam growth^l): U
-    [T][r^3][3] -> V = M^-1 U, every transition's values the columns of one
+    [T][r^3][C] -> V = M^-1 U, every transition's values the columns of one
     solve make(r, lambda_l) (nt.dense_solver or nt.basis_solver; level 0,
     one node, has L = 0: M = I)."""
     def level(r, solve):
-        return lambda U: solve(U.transpose(0, 1).reshape(r ** 3, -1)).reshape(r ** 3, -1, 3).transpose(0, 1)
+        return lambda U: (solve(U.transpose(0, 1).reshape(r ** 3, -1))
+                          .reshape(r ** 3, U.shape[0], U.shape[2]).transpose(0, 1))
 
     return [level(1 + 2 * l, make(1 + 2 * l, lam * growth ** l)) for l in range(levels)]
 
@@ -49,16 +56,37 @@ def uniform_laplacian(faces, nv):
 
 
 def sample(V, x):
-    """V [r^3][3] (x fastest) at points x [n][3]: [n][3]."""
+    """V [r^3][C] (x fastest) at points x [n][3]: [n][C]."""
     r = round(V.shape[0] ** (1 / 3))
-    vol = V.reshape(r, r, r, 3).permute(3, 0, 1, 2)[None]  # [1][3][z][y][x]
+    vol = V.reshape(r, r, r, -1).permute(3, 0, 1, 2)[None]  # [1][C][z][y][x]
     out = F.grid_sample(vol, x[None, None, None], mode="bilinear", padding_mode="border", align_corners=True)
     return out[0, :, 0, 0].T
 
 
-def move(V_levels, g, x):
+def cayley(r):
+    """R [n][3][3] = (I - K)^-1 (I + K), K = [r]x, of r [n][3]."""
+    zero = torch.zeros_like(r[:, 0])
+    K = torch.stack([torch.stack([zero, -r[:, 2], r[:, 1]], -1),
+                     torch.stack([r[:, 2], zero, -r[:, 0]], -1),
+                     torch.stack([-r[:, 1], r[:, 0], zero], -1)], 1)
+    eye = torch.eye(3).expand_as(K)
+    return torch.linalg.solve(eye - K, eye + K)
+
+
+def step(V_levels, g, x):
+    """Field g's affine step [n][3][4] = [R | 0.1 tanh(s_t)] at points x [n][3]."""
     s = sum(sample(V[g], x) for V in V_levels) / len(V_levels)
-    return x + 0.1 * torch.tanh(s)
+    R = cayley(s[:, :3]) if s.shape[1] == 6 else torch.eye(3).expand(len(x), 3, 3)
+    return torch.cat([R, 0.1 * torch.tanh(s[:, -3:])[:, :, None]], 2)
+
+
+def compose(A, S):
+    """A [n][3][4] times S [n][3][4], both affine (last row 0 0 0 1)."""
+    return torch.cat([A[:, :, :3] @ S[:, :, :3], A[:, :, :3] @ S[:, :, 3:] + A[:, :, 3:]], 2)
+
+
+def apply(A, x):
+    return (A[:, :, :3] @ x[:, :, None])[:, :, 0] + A[:, :, 3]
 
 
 def nearest_dense(X, P):
@@ -82,7 +110,8 @@ def objective(V_levels, v, P, key, edges, epoch, epochs, warmup, nearest=nearest
     """(total, input, pred, edge) of one epoch; v the template (detached here)."""
     n = len(P)
     T = n - 1
-    L_in = sum(robust_chamfer(move(V_levels, g, P[g + 1 if g < key else g]), P[g if g < key else g + 1], nearest)
+    src = lambda g: P[g + 1 if g < key else g]
+    L_in = sum(robust_chamfer(apply(step(V_levels, g, src(g)), src(g)), P[g if g < key else g + 1], nearest)
                for g in range(T)) / T
     zero = torch.zeros(())
     if epoch < warmup:
@@ -91,6 +120,7 @@ def objective(V_levels, v, P, key, edges, epoch, epochs, warmup, nearest=nearest
     lens = [key, n - 1 - key]
     M = max(lens)
     x = [v, v]
+    A = [torch.cat([torch.eye(3), torch.zeros(3, 1)], 1).expand(len(v), 3, 4)] * 2
     e = 1 - (epoch / epochs) ** 0.5
     s, S = 1.0, 0.0
     pred, edge = zero, zero
@@ -99,7 +129,8 @@ def objective(V_levels, v, P, key, edges, epoch, epochs, warmup, nearest=nearest
         CD, E = zero, zero
         for k in live:
             g, t = (key - m, key - m) if k == 0 else (key + m - 1, key + m)
-            nx = move(V_levels, g, x[k])
+            A[k] = compose(A[k], step(V_levels, g, x[k]))
+            nx = apply(A[k], v)
             CD = CD + robust_chamfer(nx, P[t], nearest) / len(live)
             E = E + edge_l1(nx, x[k], edges) / len(live)
             x[k] = nx

@@ -1,6 +1,7 @@
 #define _XOPEN_SOURCE 700 /* nftw */
 #include "testutil.h"
 
+#include "methods/pdg/field.h"
 #include "tcb/rng.h"
 
 #include <dirent.h>
@@ -174,4 +175,56 @@ double tu_ref_chamfer_way(const double *q, int nq, const double *to, int nt, con
         sum += w * best;
     }
     return sum;
+}
+
+double tu_central(double (*f)(const void *ctx), const void *ctx, double *z, double h)
+{
+    double keep = *z;
+    *z = keep + h;
+    double lp = f(ctx);
+    *z = keep - h;
+    double lm = f(ctx);
+    *z = keep;
+    return (lp - lm) / (2.0 * h);
+}
+
+void tu_ref_cayley(const double r[3], double R[9])
+{
+    const double K[9] = {0, -r[2], r[1], r[2], 0, -r[0], -r[1], r[0], 0};
+    double M[9], P[9], adj[9];
+    for (int i = 0; i < 9; i++) M[i] = (i % 4 == 0) - K[i], P[i] = (i % 4 == 0) + K[i];
+    for (int i = 0; i < 3; i++) /* adj[i][j] = cofactor of M[j][i] */
+        for (int j = 0; j < 3; j++) {
+            int a0 = (j + 1) % 3, a1 = (j + 2) % 3, b0 = (i + 1) % 3, b1 = (i + 2) % 3;
+            adj[3 * i + j] = M[3 * a0 + b0] * M[3 * a1 + b1] - M[3 * a0 + b1] * M[3 * a1 + b0];
+        }
+    double det = M[0] * adj[0] + M[1] * adj[3] + M[2] * adj[6];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            R[3 * i + j] = 0.0;
+            for (int k = 0; k < 3; k++) R[3 * i + j] += adj[3 * i + k] * P[3 * k + j] / det;
+        }
+}
+
+void tu_ref_pdg_step(const struct tcb_pdg_fields *f, const double *V, int g, const double x[3], const double x0[3],
+                     const double *A, double *A_out, double y[3])
+{
+    double s[6] = {0}, o[6], R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, T[12], out[12];
+    for (int l = 0; l < f->levels; l++) {
+        tu_ref_trilinear(V + f->off[l] + (size_t)g * f->r[l] * f->r[l] * f->r[l] * f->C, f->r[l], f->C, x, o);
+        for (int c = 0; c < f->C; c++) s[c] += o[c] / f->levels;
+    }
+    if (f->C == 6) tu_ref_cayley(s, R);
+    for (int a = 0; a < 3; a++) {
+        for (int b = 0; b < 3; b++) T[4 * a + b] = R[3 * a + b];
+        T[4 * a + 3] = 0.1 * tanh(s[f->C - 3 + a]);
+    }
+    for (int a = 0; a < 3; a++) /* A' = A · [T; 0 0 0 1] */
+        for (int b = 0; b < 4; b++) {
+            double sum = A ? (b == 3) * A[4 * a + 3] : T[4 * a + b];
+            for (int k = 0; A && k < 3; k++) sum += A[4 * a + k] * T[4 * k + b];
+            out[4 * a + b] = sum;
+        }
+    for (int a = 0; a < 3; a++) y[a] = out[4 * a] * x0[0] + out[4 * a + 1] * x0[1] + out[4 * a + 2] * x0[2] + out[4 * a + 3];
+    if (A_out) memcpy(A_out, out, sizeof out);
 }

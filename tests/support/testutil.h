@@ -63,6 +63,24 @@ void tu_ref_trilinear(const double *values, int r, int F, const double p[3], dou
  * NULL. */
 double tu_ref_chamfer_way(const double *q, int nq, const double *to, int nt, const double *w_in, double *w_out);
 
+/* The central difference (f(ctx) at *z + h − at *z − h) / 2h: f's
+ * derivative in *z, one of the numbers it reads through ctx (restored). */
+double tu_central(double (*f)(const void *ctx), const void *ctx, double *z, double h);
+
+/* R [3][3] row-major = (I − K)⁻¹(I + K), K = [r]× (K v = r × v), in double
+ * by the adjugate of I − K: the Cayley map as defined, the reference of
+ * PDG's closed form. */
+void tu_ref_cayley(const double r[3], double R[9]);
+
+/* PDG's step of one point through field g of f (methods/pdg/field.h), in
+ * double, as the release composes its transforms: s [C] the mean of field
+ * g's levels sampled at x (tu_ref_trilinear); R the identity (C = 3) or
+ * tu_ref_cayley(s[0..2]) (C = 6); A' = A · [R | 0.1 tanh(s_t)], A [12]
+ * row-major 3×4 (NULL: the identity); y = A' x0. A_out [12] may be NULL. */
+struct tcb_pdg_fields;
+void tu_ref_pdg_step(const struct tcb_pdg_fields *f, const double *V, int g, const double x[3], const double x0[3],
+                     const double *A, double *A_out, double y[3]);
+
 /* 1 when nf triangles form closed surfaces, consistently oriented: every
  * directed edge occurs once and its reverse occurs too (so each undirected
  * edge has exactly two faces, wound opposite ways); 0 otherwise. */
