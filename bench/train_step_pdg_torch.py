@@ -24,7 +24,7 @@ matrix's GEMM form without autograd, then the matches' distances with it
 afresh).
 
 The epochs count from 0 with every term active, as the C row's training
-(warm-up 0), the catch-up exponent following epoch / EPOCHS. One warm-up
+(its train_steps' main phase: warm-up 0), the catch-up exponent following epoch / EPOCHS. One warm-up
 step, then `iters` timed steps. Prints one line: "<mean ms per step>
 <peak RSS of this process in KiB>"; with --losses, the first two steps'
 loss parts on stderr. Exit 77 (and a message on stderr) when torch or
