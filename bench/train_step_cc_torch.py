@@ -40,6 +40,7 @@ def main():
         sys.exit(2)
     c, z, h, l, b, n, iters, threads = (int(a) for a in args)
     torch.set_num_threads(threads)
+    torch_peer.keep_freed_memory()
     torch.manual_seed(1)
     model = cc_torch.build(c, z, h, l)
     model.train()

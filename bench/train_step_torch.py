@@ -28,6 +28,7 @@ def main():
     c, p, m, n, iters, threads = (int(a) for a in sys.argv[2:8])
     warmup = int(sys.argv[8]) if len(sys.argv) > 8 else 1
     torch.set_num_threads(threads)
+    torch_peer.keep_freed_memory()
     torch.manual_seed(1)
     model = atlas_torch.Atlas(c, p)
     opt = torch.optim.Adam(model.parameters(), lr=1e-3)
