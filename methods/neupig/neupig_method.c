@@ -100,7 +100,7 @@ static int parse(const char *params_json, void *obj, tcb_error *err)
     m->arch.levels = (int)levels, m->arch.features = (int)features, m->arch.hidden = (int)hidden;
     m->arch.laplacian = (tcb_sobolev_laplacian)li;
     m->sched.epochs = epochs, m->sched.lr_grid = 0.005, m->sched.lr_growth = 2.5, m->sched.lr_mlp = 1e-3;
-    b->hooks = &hooks, b->fitted.method = "neupig";
+    b->hooks = &hooks, b->fitted.method = hooks.name;
     b->epochs = epochs, b->points = (int)points, b->keyframe_res = TCB_PCGRID_KEYFRAME_RES;
     b->spec = (tcb_pcgrid_template_spec){.poisson_depth = (int)depth, .template_faces = (int)faces};
     return TCB_OK;

@@ -147,7 +147,6 @@ static void release_model(tcb_pcgrid_method *b)
 {
     free(b->params);
     b->params = NULL, b->n_params = 0;
-    b->fitted.method = b->hooks->name;
     tcb_pcgrid_fitted_release(&b->fitted);
 }
 

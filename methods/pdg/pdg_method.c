@@ -102,7 +102,7 @@ static int parse(const char *params_json, void *obj, tcb_error *err)
     m->arch.rotation = (tcb_pdg_rotation)rotation;
     m->sched.epochs = epochs, m->sched.warmup = warmup;
     m->sched.lr_grid = 0.005, m->sched.lr_growth = 1.1, m->sched.lr_template = 1e-4;
-    b->hooks = &hooks, b->fitted.method = "pdg";
+    b->hooks = &hooks, b->fitted.method = hooks.name;
     b->epochs = epochs, b->points = (int)points, b->keyframe_res = (int)kres;
     b->spec = (tcb_pcgrid_template_spec){.poisson_depth = (int)depth,
                                          .template_faces = (int)faces,
