@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -26,10 +27,11 @@ static const double PALETTE[][3] = {
 static const double DASHES[][4] = {{0}, {7, 4}, {2, 3}, {8, 3, 2, 3}};
 static const int N_DASH_STEPS[] = {0, 2, 2, 4};
 #define N_DASHES ((int)(sizeof DASHES / sizeof DASHES[0]))
-/* The first salt (tcb_chart_style_of) under which the labels of every shipped
- * config (configs/, configs/paper/) get distinct colours, and table3-alpha's
- * sixteen distinct colour-and-dash pairs (test_plots checks it; a config
- * that adds a label may need the search again: a numpy loop over salts). */
+/* A salt under which the labels of the configs shipped before pdg got
+ * distinct colours: kept so that their pictures keep theirs. Beyond a
+ * handful of labels no salt can promise that (nine labels in ten colours
+ * collide for all but 0.4% of hashes), so tcb_chart_styles resolves a
+ * plot's collisions instead. */
 #define STYLE_SALT 1869495u
 
 int tcb_chart_style_of(const char *label)
@@ -39,6 +41,28 @@ int tcb_chart_style_of(const char *label)
     for (const unsigned char *p = (const unsigned char *)label; *p; p++) h = (h ^ *p) * 16777619u;
     h ^= h >> 16, h *= 0x85ebca6bu, h ^= h >> 13, h *= 0xc2b2ae35u, h ^= h >> 16;
     return (int)(h % (N_COLOURS * N_DASHES));
+}
+
+/* The key two labels of one plot must not share: the colour while there are
+ * colours for all, else the colour and dash. */
+static int style_key(int style, int n) { return n <= N_COLOURS ? style % N_COLOURS : style; }
+
+void tcb_chart_styles(const char *const *label, int n, int *style)
+{
+    enum { N_STYLES = N_COLOURS * N_DASHES };
+    int n_keys = n <= N_COLOURS ? N_COLOURS : N_STYLES, taken[N_STYLES] = {0}, n_taken = 0;
+    for (int k = 0; k < n; k++) style[k] = -1;
+    for (int done = 0; done < n; done++) {
+        int k = -1; /* the first label, in strcmp order, not yet styled */
+        for (int j = 0; j < n; j++)
+            if (style[j] < 0 && (k < 0 || strcmp(label[j], label[k]) < 0)) k = j;
+        int own = tcb_chart_style_of(label[k]), key = style_key(own, n);
+        /* more labels than styles: the later ones share (their own style) */
+        if (n_taken < n_keys)
+            while (taken[key]) key = (key + 1) % n_keys;
+        if (!taken[key]) taken[key] = 1, n_taken++;
+        style[k] = n <= N_COLOURS ? own / N_COLOURS * N_COLOURS + key : key;
+    }
 }
 
 /* Where v lies along the axis, 0 at its start and 1 at its end. */
@@ -119,9 +143,27 @@ static void draw_ticks(tcb_chart *c, int y_axis)
     }
 }
 
-void tcb_chart_begin(tcb_chart *c, const tcb_chart_axis *x, const tcb_chart_axis *y)
+/* The styles of block b's rows (rows are distinct methods); NULL when the
+ * array cannot be had, which tcb_chart_finish reports. */
+static int *row_styles(const tcb_rpt_block *b)
+{
+    int *style = malloc(sizeof *style * (size_t)b->n_rows);
+    const char **label = malloc(sizeof *label * (size_t)b->n_rows);
+    if (style && label) {
+        for (int k = 0; k < b->n_rows; k++) label[k] = b->rows[k].method;
+        tcb_chart_styles(label, b->n_rows, style);
+    } else {
+        free(style), style = NULL;
+    }
+    free(label);
+    return style;
+}
+
+void tcb_chart_begin(tcb_chart *c, const tcb_chart_axis *x, const tcb_chart_axis *y, const tcb_rpt_block *b)
 {
     c->x = *x, c->y = *y;
+    c->n_rows = b ? b->n_rows : 0;
+    c->style = c->n_rows ? row_styles(b) : NULL;
     c->surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H);
     c->cr = cairo_create(c->surface);
     cairo_t *cr = c->cr;
@@ -143,23 +185,22 @@ void tcb_chart_begin(tcb_chart *c, const tcb_chart_axis *x, const tcb_chart_axis
     cairo_restore(cr);
 }
 
-static void set_style(cairo_t *cr, const char *label)
+static void set_style(cairo_t *cr, int s)
 {
-    int s = tcb_chart_style_of(label);
     const double *rgb = PALETTE[s % N_COLOURS];
     cairo_set_source_rgb(cr, rgb[0], rgb[1], rgb[2]);
     cairo_set_line_width(cr, 2.2);
     cairo_set_dash(cr, DASHES[s / N_COLOURS], N_DASH_STEPS[s / N_COLOURS], 0);
 }
 
-void tcb_chart_series_begin(tcb_chart *c, const char *label)
+void tcb_chart_series_begin(tcb_chart *c, int k)
 {
     cairo_save(c->cr);
     /* A line at exactly the axis end must stay visible, not be half clipped. */
     cairo_rectangle(c->cr, X0, Y0 - 2, X1 - X0, Y1 - Y0 + 2);
     cairo_clip(c->cr);
     cairo_set_line_join(c->cr, CAIRO_LINE_JOIN_ROUND);
-    set_style(c->cr, label);
+    set_style(c->cr, k >= 0 && k < c->n_rows && c->style ? c->style[k] : 0);
 }
 
 void tcb_chart_series_end(tcb_chart *c) { cairo_restore(c->cr); }
@@ -192,7 +233,7 @@ void tcb_chart_legend(tcb_chart *c, const tcb_rpt_block *b, const char *heading,
         const tcb_rpt_row *r = &b->rows[k];
         char label[160];
         if (!strcmp(r->status, "ok")) {
-            set_style(cr, r->method);
+            set_style(cr, k < c->n_rows && c->style ? c->style[k] : 0);
             cairo_move_to(cr, LEGEND_X, y);
             cairo_line_to(cr, LEGEND_X + 28, y);
             cairo_stroke(cr);
@@ -246,6 +287,8 @@ int tcb_chart_finish(tcb_chart *c, const char *path, tcb_error *err)
 {
     char tmp[TCB_PATH_MAX];
     cairo_status_t st = cairo_status(c->cr);
+    if (c->n_rows && !c->style) st = CAIRO_STATUS_NO_MEMORY;
+    free(c->style), c->style = NULL;
     cairo_destroy(c->cr);
     int rc = tcb_temp_path_for(path, tmp, sizeof tmp, err);
     if (!rc && st == CAIRO_STATUS_SUCCESS) st = cairo_surface_write_to_png(c->surface, tmp);

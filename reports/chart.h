@@ -2,9 +2,10 @@
  * file only maps its data. A 900×600 PNG: axes from 0 with a light grid, a
  * legend panel right of the axes (it can never hide a curve), a title with
  * the block's role, pairs and seeds, and one style per method label that is
- * the same in every plot (tcb_chart_style_of).
+ * the same in every plot of a block and, unless two labels of a block would
+ * share it, in every report (tcb_chart_styles).
  *
- * Use: tcb_chart_begin, then for each series tcb_chart_series_begin …
+ * Use: tcb_chart_begin, then for each row tcb_chart_series_begin …
  * cairo drawing at (tcb_chart_px, tcb_chart_py) … tcb_chart_series_end,
  * then tcb_chart_legend, tcb_chart_title and tcb_chart_finish, which
  * publishes the file atomically and frees the chart whatever happened. */
@@ -28,26 +29,35 @@ typedef struct tcb_chart {
     cairo_surface_t *surface;
     cairo_t *cr;
     tcb_chart_axis x, y;
+    int n_rows;
+    int *style;          /* malloc'ed [n_rows]: the rows' styles (tcb_chart_styles) */
 } tcb_chart;
 
-/* A white canvas with the axes drawn. */
-void tcb_chart_begin(tcb_chart *c, const tcb_chart_axis *x, const tcb_chart_axis *y);
+/* A white canvas with the axes drawn, and the styles of block b's rows
+ * (b NULL: a plot of one series). */
+void tcb_chart_begin(tcb_chart *c, const tcb_chart_axis *x, const tcb_chart_axis *y, const tcb_rpt_block *b);
 
 /* Device coordinates of a data value. */
 double tcb_chart_px(const tcb_chart *c, double x);
 double tcb_chart_py(const tcb_chart *c, double y);
 
-/* A method label's style: colour index (style % 10) and dash pattern
- * (style / 10, solid first) of 40, a function of the label alone, so that
- * a method keeps its colour in every plot of every report whatever rows
- * are added or removed. The price of that: two labels can share a colour
- * (then most often not the dash); the salt is chosen so that the labels of
- * each shipped config do not. NULL (a plot of one series): 0, the first
- * colour, solid. */
+/* A method label's own style: colour index (style % 10) and dash pattern
+ * (style / 10, solid first) of 40, a hash of the label alone, so that a
+ * method keeps its colour in every plot of every report whatever rows are
+ * added or removed. */
 int tcb_chart_style_of(const char *label);
 
-/* Clip to the plot area and take the label's colour, width and dash. */
-void tcb_chart_series_begin(tcb_chart *c, const char *label);
+/* The styles of n distinct labels drawn together: each label's own style,
+ * except that labels are taken in strcmp order and one whose colour (with
+ * more than 10 labels: whose colour and dash) an earlier label holds takes
+ * the next free one. So the labels of one plot never share a colour while
+ * there are colours for all, and in a plot without a collision every label
+ * has its own style. */
+void tcb_chart_styles(const char *const *label, int n, int *style);
+
+/* Clip to the plot area and take row k's colour, width and dash (k −1:
+ * the one series of a plot begun without a block). */
+void tcb_chart_series_begin(tcb_chart *c, int k);
 void tcb_chart_series_end(tcb_chart *c);
 
 /* One legend entry per row: "method (value)" with row r's mean of `metric`

@@ -64,10 +64,11 @@ static void marker(tcb_chart *c, double x, double v)
     cairo_fill(c->cr);
 }
 
-static void draw_row(tcb_chart *c, const tcb_rpt_row *r)
+static void draw_row(tcb_chart *c, const tcb_rpt_block *b, int k)
 {
+    const tcb_rpt_row *r = &b->rows[k];
     const double scale = tcb_rpt_metrics[TCB_M_SL2].scale;
-    tcb_chart_series_begin(c, r->method);
+    tcb_chart_series_begin(c, k);
     for (int g = 0; g < r->n_gaps; g++) {
         if (!r->by_gap[g].n_pairs) continue;
         double x = tcb_chart_px(c, g), y = py(c, r->by_gap[g].sl2.mean * scale);
@@ -94,9 +95,9 @@ int tcb_rpt_plot_gap(const tcb_rpt_block *b, const char *path, tcb_error *err)
                               .label = "frame distance |i − j|"};
     const tcb_chart_axis y = y_axis(max_err, min_pos);
     tcb_chart c;
-    tcb_chart_begin(&c, &x, &y);
+    tcb_chart_begin(&c, &x, &y, b);
     for (int k = 0; k < b->n_rows; k++)
-        if (b->rows[k].n_gaps) draw_row(&c, &b->rows[k]);
+        if (b->rows[k].n_gaps) draw_row(&c, b, k);
     tcb_chart_legend(&c, b, "method (m_sL2)", TCB_M_SL2);
     tcb_chart_title(&c, b, "m_sL2 by frame distance");
     char note[160];

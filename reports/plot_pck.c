@@ -28,12 +28,12 @@ static int plot(const tcb_rpt_block *b, const pck_plot *p, const char *path, tcb
 {
     const tcb_chart_axis y = {.max = 100.0, .n_ticks = 5, .format = "%.0f", .label = "PCK (%)"};
     tcb_chart c;
-    tcb_chart_begin(&c, &p->x, &y);
+    tcb_chart_begin(&c, &p->x, &y, b);
     for (int k = 0; k < b->n_rows; k++) {
         const tcb_rpt_row *r = &b->rows[k];
         if (strcmp(r->status, "ok") || !r->has[p->metric]) continue;
         const double *pck = p->curve(r);
-        tcb_chart_series_begin(&c, r->method);
+        tcb_chart_series_begin(&c, k);
         for (int s = 0; s < p->steps; s++) {
             double px = tcb_chart_px(&c, p->threshold(s)), py = tcb_chart_py(&c, pck[s]);
             if (s == 0) cairo_move_to(c.cr, px, py);

@@ -29,8 +29,8 @@ int tcb_plot_yaw(const char *path, const char *sequence, const int *step, int n_
     const tcb_chart_axis y = {.min = -180.0, .max = 180.0, .n_ticks = 6, .format = "%.0f",
                               .label = "yaw (degrees about y)"};
     tcb_chart c;
-    tcb_chart_begin(&c, &x, &y);
-    tcb_chart_series_begin(&c, NULL);
+    tcb_chart_begin(&c, &x, &y, NULL);
+    tcb_chart_series_begin(&c, -1);
     for (int f = 0; f < n_frames; f++) {
         double px = tcb_chart_px(&c, f), py = tcb_chart_py(&c, yaw_degrees(step[f]));
         /* a jump of more than half a turn is a wrap through ±180°, not a swing */

@@ -128,28 +128,76 @@ static void test_colour_follows_the_label(void **state)
     tu_remove_tree(two), tu_remove_tree(three);
 }
 
-/* The salt's promise, checked on the configs themselves: within each
- * shipped config the method labels have distinct colours (distinct
- * colour-and-dash pairs where there are more labels than colours). */
+/* Distinct keys: colours up to 10 labels, colour-and-dash pairs beyond. */
+static int distinct_styles(const int *style, int n)
+{
+    int modulus = n <= 10 ? 10 : 40;
+    for (int a = 0; a < n; a++)
+        for (int b = a + 1; b < n; b++)
+            if (style[a] % modulus == style[b] % modulus) return 0;
+    return 1;
+}
+
+/* Within each shipped config the method labels have distinct colours
+ * (distinct colour-and-dash pairs where there are more than ten). */
 static void check_config_styles(const char *path, void *arg)
 {
     (void)arg;
     tcb_config c;
     tcb_error err = {0};
     if (tcb_config_load(path, &c, &err)) fail_msg("%s", err.msg);
-    int modulus = c.n_methods <= 10 ? 10 : 40;
-    for (int a = 0; a < c.n_methods; a++)
-        for (int b = a + 1; b < c.n_methods; b++)
-            if (tcb_chart_style_of(c.methods[a].label) % modulus == tcb_chart_style_of(c.methods[b].label) % modulus)
-                fail_msg("%s: %s and %s share a %s", path, c.methods[a].label, c.methods[b].label,
-                         modulus == 10 ? "colour" : "colour and dash");
-    tcb_config_free(&c);
+    const char **label = malloc(sizeof *label * (size_t)c.n_methods);
+    int *style = malloc(sizeof *style * (size_t)c.n_methods);
+    assert_non_null(label), assert_non_null(style);
+    for (int k = 0; k < c.n_methods; k++) label[k] = c.methods[k].label;
+    tcb_chart_styles(label, c.n_methods, style);
+    int ok = distinct_styles(style, c.n_methods);
+    free(label), free(style), tcb_config_free(&c);
+    if (!ok) fail_msg("%s: two labels share a style", path);
 }
 
 static void test_shipped_labels_have_their_own_colours(void **state)
 {
     (void)state;
     assert_true(tu_for_each_json(TCB_SOURCE_DIR "/configs", check_config_styles, NULL) >= 10);
+}
+
+/* "atlasnet" and "pdg" hash to one colour: the first in strcmp order keeps
+ * it, whatever the order given, and the other takes the next free one. */
+static void test_a_collision_moves_the_later_label(void **state)
+{
+    (void)state;
+    assert_int_equal(tcb_chart_style_of("atlasnet") % 10, tcb_chart_style_of("pdg") % 10);
+    const char *const ab[] = {"pdg", "atlasnet"};
+    int style[2];
+    tcb_chart_styles(ab, 2, style);
+    assert_int_equal(style[1], tcb_chart_style_of("atlasnet"));
+    assert_int_equal(style[0] % 10, (tcb_chart_style_of("pdg") + 1) % 10);
+    assert_int_equal(style[0] / 10, tcb_chart_style_of("pdg") / 10); /* its dash stays */
+}
+
+/* Random label sets of 1 … 40: distinct styles always; each label its own
+ * style whenever the own keys were distinct already. */
+static void test_random_label_sets_never_share(void **state)
+{
+    (void)state;
+    char names[40][16];
+    const char *label[40];
+    int style[40], own[40];
+    unsigned x = 12345u;
+    for (int trial = 0; trial < 2000; trial++) {
+        int n = 1 + trial % 40;
+        for (int k = 0; k < n; k++) {
+            x = x * 1103515245u + 12345u;
+            snprintf(names[k], sizeof names[k], "m%d_%u", k, x >> 8);
+            label[k] = names[k];
+            own[k] = tcb_chart_style_of(label[k]);
+        }
+        tcb_chart_styles(label, n, style);
+        assert_true(distinct_styles(style, n));
+        if (distinct_styles(own, n))
+            for (int k = 0; k < n; k++) assert_int_equal(style[k], own[k]);
+    }
 }
 
 /* Pair 1 moved from |i - j| = 2 to 4: distances 2 and 3 have no pairs. */
@@ -220,6 +268,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_colour_follows_the_label),
         cmocka_unit_test(test_shipped_labels_have_their_own_colours),
+        cmocka_unit_test(test_a_collision_moves_the_later_label),
+        cmocka_unit_test(test_random_label_sets_never_share),
         cmocka_unit_test(test_gap_plot_shows_the_best_and_skips_holes),
         cmocka_unit_test(test_yaw_plot_in_plus_minus_180),
     };
