@@ -90,57 +90,129 @@ static void load_triangle(const float *verts, const int32_t *face, double t[3][3
         for (int d = 0; d < 3; d++) t[k][d] = verts[3 * face[k] + d];
 }
 
-/* Face centroids (float, for the k-NN index) and the largest distance of a
- * vertex from its face's centroid. */
-static double centroids(const float *verts, const int32_t *faces, int nf, float *cen)
+/* Face f's centroid (float, for the k-NN index) and its radius: the
+ * largest distance of one of its vertices from the centroid. */
+static double centroid_of(const float *verts, const int32_t *face, float *cen)
 {
-    double radius = 0;
-    for (int f = 0; f < nf; f++) {
-        double t[3][3], c[3];
-        load_triangle(verts, faces + 3 * f, t);
-        for (int d = 0; d < 3; d++) c[d] = (t[0][d] + t[1][d] + t[2][d]) / 3, cen[3 * f + d] = (float)c[d];
-        for (int k = 0; k < 3; k++) {
-            double e[3];
-            sub3(t[k], c, e);
-            radius = fmax(radius, sqrt(dot3(e, e)));
-        }
+    double t[3][3], c[3], radius = 0;
+    load_triangle(verts, face, t);
+    for (int d = 0; d < 3; d++) c[d] = (t[0][d] + t[1][d] + t[2][d]) / 3, cen[d] = (float)c[d];
+    for (int k = 0; k < 3; k++) {
+        double e[3];
+        sub3(t[k], c, e);
+        radius = fmax(radius, sqrt(dot3(e, e)));
     }
     return radius;
 }
 
+/* Faces are searched by the distance of their centroids, and a face whose
+ * centroid lies beyond the best distance plus its radius cannot be closer.
+ * One radius for all faces would let a single sliver widen every query's
+ * search to thousands of faces; so faces are grouped by radius, class c
+ * holding those with radius in (r_max / 2^(c+1), r_max / 2^c] (the last
+ * class everything smaller), each with its own index and bound. */
+enum { N_CLASSES = 24 };
+
+typedef struct face_class {
+    tcb_nn *index;   /* over the class's centroids; NULL when empty */
+    int32_t *face;   /* [n]: the class's k-th centroid is face face[k]'s */
+    int n;
+    double radius;   /* the largest radius in the class */
+} face_class;
+
 typedef struct search {
     const float *verts;
     const int32_t *faces;
-    const tcb_nn *index; /* over the face centroids */
-    int nf;
-    double radius;       /* largest vertex-to-centroid distance */
-    double extent;       /* largest vertex coordinate magnitude */
-    int32_t *idx;        /* [nf] k-NN scratch */
-    float *d2;           /* [nf] */
+    face_class cls[N_CLASSES];
+    double extent;   /* largest vertex coordinate magnitude */
+    int32_t *idx;    /* [nf] k-NN scratch */
+    float *d2;       /* [nf] */
 } search;
 
-/* One query: the k nearest centroids, k doubled until the k-th is farther
- * than the best distance plus the radius (every face beyond is then
- * farther than the best), or k covers every face. */
+static int class_of(double radius, double r_max)
+{
+    int c = 0;
+    while (c < N_CLASSES - 1 && radius <= r_max / (double)(2 << c)) c++;
+    return c;
+}
+
+/* The classes and their indices; s->idx and s->d2 allocated for nf. */
+static int build_classes(search *s, int nf, tcb_error *err)
+{
+    float *cen = malloc((size_t)3 * nf * sizeof *cen), *class_cen = malloc((size_t)3 * nf * sizeof *class_cen);
+    double *radius = malloc((size_t)nf * sizeof *radius), r_max = 0;
+    int8_t *c_of = malloc((size_t)nf);
+    s->idx = malloc((size_t)nf * sizeof *s->idx);
+    s->d2 = malloc((size_t)nf * sizeof *s->d2);
+    int rc = TCB_OK;
+    if (!cen || !class_cen || !radius || !c_of || !s->idx || !s->d2) {
+        rc = tcb_fail(err, TCB_ERR_NOMEM, "locate: out of memory for %d faces", nf);
+        goto done;
+    }
+    for (int f = 0; f < nf; f++) r_max = fmax(r_max, radius[f] = centroid_of(s->verts, s->faces + 3 * f, cen + 3 * f));
+    for (int f = 0; f < nf; f++) s->cls[c_of[f] = (int8_t)class_of(radius[f], r_max)].n++;
+    for (int c = 0; c < N_CLASSES && !rc; c++) {
+        face_class *k = &s->cls[c];
+        if (!k->n) continue;
+        if (!(k->face = malloc((size_t)k->n * sizeof *k->face))) {
+            rc = tcb_fail(err, TCB_ERR_NOMEM, "locate: out of memory for %d faces", nf);
+            break;
+        }
+        int n = 0;
+        for (int f = 0; f < nf; f++)
+            if (c_of[f] == c) {
+                k->face[n] = f, k->radius = fmax(k->radius, radius[f]);
+                memcpy(class_cen + 3 * n++, cen + 3 * f, 3 * sizeof *cen);
+            }
+        rc = tcb_nn_build(class_cen, n, &k->index, err);
+    }
+done:
+    free(cen), free(class_cen), free(radius), free(c_of);
+    return rc;
+}
+
+static void free_search(search *s)
+{
+    for (int c = 0; c < N_CLASSES; c++) tcb_nn_free(s->cls[c].index), free(s->cls[c].face);
+    free(s->idx), free(s->d2);
+}
+
+/* Within one class: the k nearest centroids, k doubled until the k-th is
+ * farther than the best distance so far plus the class's radius (every
+ * face of the class beyond is then farther than the best), or k covers the
+ * class. Exact ties go to the lowest face index, whatever the order the
+ * faces are met in. */
+static int search_class(const search *s, const face_class *k, const float *query, double *best, int32_t *best_face,
+                        double *bw, tcb_error *err)
+{
+    double p[3] = {query[0], query[1], query[2]}, w[3] = {0, 0, 0};
+    /* The centroid distances are float: slack for their rounding. */
+    double slack = 1e-5 * (fmax(fabs(p[0]), fmax(fabs(p[1]), fabs(p[2]))) + s->extent);
+    for (int n = k->n < 16 ? k->n : 16;; n = 2 * n < k->n ? 2 * n : k->n) {
+        int rc = tcb_nn_queryk(k->index, query, 1, n, s->idx, s->d2, err);
+        if (rc) return rc;
+        for (int j = 0; j < n; j++) {
+            int32_t f = k->face[s->idx[j]];
+            double t[3][3];
+            load_triangle(s->verts, s->faces + 3 * f, t);
+            double d2 = closest_on_triangle(p, t, w);
+            if (d2 < *best || (d2 == *best && f < *best_face)) *best = d2, *best_face = f, memcpy(bw, w, sizeof w);
+        }
+        if (n == k->n || sqrt((double)s->d2[n - 1]) > sqrt(*best) + k->radius + slack) return TCB_OK;
+    }
+}
+
+/* One query: the classes from the smallest faces (most of the mesh, and
+ * the tightest bound) to the largest, each pruned by the best so far. */
 static int locate_one(const search *s, const float *query, tcb_surface_point *out, float *dist2,
                       tcb_error *err)
 {
-    double p[3] = {query[0], query[1], query[2]}, best = INFINITY, w[3] = {0, 0, 0}, bw[3] = {1, 0, 0};
+    double best = INFINITY, bw[3] = {1, 0, 0};
     int32_t best_face = 0;
-    for (int k = s->nf < 16 ? s->nf : 16;; k = 2 * k < s->nf ? 2 * k : s->nf) {
-        int rc = tcb_nn_queryk(s->index, query, 1, k, s->idx, s->d2, err);
+    for (int c = N_CLASSES - 1; c >= 0; c--) {
+        if (!s->cls[c].n) continue;
+        int rc = search_class(s, &s->cls[c], query, &best, &best_face, bw, err);
         if (rc) return rc;
-        for (int j = 0; j < k; j++) {
-            double t[3][3];
-            load_triangle(s->verts, s->faces + 3 * s->idx[j], t);
-            double d2 = closest_on_triangle(p, t, w);
-            if (d2 < best || (d2 == best && s->idx[j] < best_face))
-                best = d2, best_face = s->idx[j], memcpy(bw, w, sizeof w);
-        }
-        /* The centroid distances are float: slack for their rounding. */
-        double mag = fmax(fabs(p[0]), fmax(fabs(p[1]), fabs(p[2]))) + s->extent;
-        double bound = sqrt(best) + s->radius + 1e-5 * mag;
-        if (k == s->nf || sqrt((double)s->d2[k - 1]) > bound) break;
     }
     out->face = best_face;
     for (int d = 0; d < 3; d++) out->bary[d] = (float)bw[d];
@@ -169,25 +241,11 @@ int tcb_mesh_locate(const float *verts, int nv, const int32_t *faces, int nf, co
 {
     int rc = check_input(verts, nv, faces, nf, queries, nq, err);
     if (rc || nq == 0) return rc;
-    search s = {.verts = verts, .faces = faces, .nf = nf};
-    float *cen = malloc((size_t)3 * nf * sizeof *cen);
-    s.idx = malloc((size_t)nf * sizeof *s.idx);
-    s.d2 = malloc((size_t)nf * sizeof *s.d2);
-    tcb_nn *index = NULL;
-    if (!cen || !s.idx || !s.d2) {
-        rc = tcb_fail(err, TCB_ERR_NOMEM, "locate: out of memory for %d faces", nf);
-        goto done;
-    }
-    s.radius = centroids(verts, faces, nf, cen);
+    search s = {.verts = verts, .faces = faces};
     for (int i = 0; i < 3 * nv; i++) s.extent = fmax(s.extent, fabs(verts[i]));
-    if ((rc = tcb_nn_build(cen, nf, &index, err))) goto done;
-    s.index = index;
+    rc = build_classes(&s, nf, err);
     for (int q = 0; q < nq && !rc; q++) rc = locate_one(&s, queries + 3 * q, out + q, dist2 ? dist2 + q : NULL, err);
-done:
-    tcb_nn_free(index);
-    free(cen);
-    free(s.idx);
-    free(s.d2);
+    free_search(&s);
     return rc;
 }
 

@@ -23,9 +23,10 @@ typedef struct tcb_surface_point {
 } tcb_surface_point;
 
 /* For each of nq queries, the closest point of the surface (verts [nv][3],
- * faces [nf][3]) — exact, not the closest vertex: faces are pruned by the
- * distance of their centroids, bounded by their largest vertex-to-centroid
- * radius. dist2 [nq] (may be NULL) receives the squared distance. Fails on
+ * faces [nf][3]) — exact, not the closest vertex, exact ties to the lowest
+ * face index: faces are pruned by the distance of their centroids, bounded
+ * by the largest vertex-to-centroid radius among faces of their size class.
+ * dist2 [nq] (may be NULL) receives the squared distance. Fails on
  * an empty mesh, face indices outside [0, nv) and non-finite coordinates. */
 int tcb_mesh_locate(const float *verts, int nv, const int32_t *faces, int nf, const float *queries, int nq,
                     tcb_surface_point *out, float *dist2, tcb_error *err);
