@@ -22,5 +22,19 @@ CC=clang cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTCB_FUZZ=O
 cmake --build build-fuzz -j"$(nproc)" --target fuzz_targets >/dev/null
 export TCBENCH_RELEASE="$PWD/build/tcbench"
 export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1
-(cd build-test && ctest --output-on-failure -j"$(nproc)" "$@")
-(cd build-fuzz && ctest --output-on-failure -j"$(nproc)" "$@")
+# Each suite's log is kept so that its ten slowest tests are printed at the
+# end, passed or not: the next test that makes the suite slow is visible.
+log=$(mktemp -d)
+trap 'rm -rf "$log"' EXIT
+slowest() {
+    echo "ten slowest tests ($1):"
+    sed -nE 's/^ *[0-9]+\/[0-9]+ Test +#[0-9]+: ([^ ]+) [ .*]*[A-Za-z]+ +([0-9.]+) sec$/\2 \1/p' "$log/$1" |
+        sort -rn | head -10 | awk '{ printf "  %8.1f s  %s\n", $1, $2 }'
+}
+status=0
+(cd build-test && ctest --output-on-failure -j"$(nproc)" "$@") 2>&1 | tee "$log/tests" || status=1
+slowest tests
+[ "$status" = 0 ] || exit 1
+(cd build-fuzz && ctest --output-on-failure -j"$(nproc)" "$@") 2>&1 | tee "$log/fuzz" || status=1
+slowest fuzz
+exit "$status"
