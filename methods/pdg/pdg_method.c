@@ -10,7 +10,9 @@
  * Params (presets overridable key by key; default cpu):
  *   preset        paper (5 000 epochs, 5 000 points a frame, 10 levels,
  *                 depth 10), cpu (sizes for 2 cores: docs/protocol.md,
- *                 "PDG"), tiny (tests)
+ *                 "PDG"), tiny (tests); paper-cayley and cpu-cayley are
+ *                 paper and cpu with the cayley rotation, presets so that
+ *                 calibrate measures their dearer epochs
  *   normals       input (default) | estimated | gt: the keyframe's normals
  *                 for the Poisson surface, as neupig's
  *   keyframe_res  the keyframe rule's lattice (128, the release's default;
@@ -48,14 +50,17 @@
 typedef struct pdg_preset {
     long long epochs, warmup;
     int points, poisson_depth, levels;
+    tcb_pdg_rotation rotation;
 } pdg_preset;
 
 static const pdg_preset presets[] = {
-    {5000, 101, 5000, 10, 10}, /* paper */
-    {2000, 101, 2500, 8, 10},  /* cpu: about 12 min a crane clip, 22 min the cat (docs/protocol.md) */
-    {40, 10, 300, 6, 3},       /* tiny: the chains train too */
+    {5000, 101, 5000, 10, 10, TCB_PDG_RELEASED}, /* paper */
+    {2000, 101, 2500, 8, 10, TCB_PDG_RELEASED},  /* cpu: about 12 min a crane clip, 22 min the cat (docs/protocol.md) */
+    {40, 10, 300, 6, 3, TCB_PDG_RELEASED},       /* tiny: the chains train too */
+    {5000, 101, 5000, 10, 10, TCB_PDG_CAYLEY},   /* paper-cayley */
+    {2000, 101, 2500, 8, 10, TCB_PDG_CAYLEY},    /* cpu-cayley */
 };
-static const char *const preset_names[] = {"paper", "cpu", "tiny", NULL};
+static const char *const preset_names[] = {"paper", "cpu", "tiny", "paper-cayley", "cpu-cayley", NULL};
 
 typedef struct pdg_method {
     tcb_pcgrid_method base;        /* first: the shared ops take the object as it */
@@ -80,7 +85,7 @@ static int parse(const char *params_json, void *obj, tcb_error *err)
     cJSON *j;
     int rc = tcb_params_parse(params_json, where, keys, &j, err);
     if (rc) return rc;
-    int pi = 1, rotation = TCB_PDG_RELEASED;
+    int pi = 1, rotation;
     long long epochs, warmup, points = 0, faces, depth, levels, kres;
     rc = tcb_json_enum(j, "preset", where, 0, 1, preset_names, &pi, err);
     if (!rc) rc = tcb_pcgrid_parse_common(j, where, b, err);
@@ -94,7 +99,7 @@ static int parse(const char *params_json, void *obj, tcb_error *err)
     if (!rc) rc = tcb_json_int(j, "levels", where, 0, p->levels, 1, TCB_PDG_MAX_LEVELS, &levels, err);
     if (!rc) rc = tcb_json_int(j, "keyframe_res", where, 0, 128, 1, 4096, &kres, err);
     if (!rc) rc = tcb_json_num(j, "divergence", where, 0, 1e4, 0, 1e300, &m->sched.divergence, err);
-    if (!rc) rc = tcb_json_enum(j, "rotation", where, 0, TCB_PDG_RELEASED, tcb_pdg_rotation_names, &rotation, err);
+    if (!rc) rc = tcb_json_enum(j, "rotation", where, 0, p->rotation, tcb_pdg_rotation_names, &rotation, err);
     cJSON_Delete(j);
     if (rc) return rc;
     m->arch = tcb_pdg_arch_reference();
@@ -193,9 +198,9 @@ static const tcb_pcgrid_hooks hooks = {
 
 /* ---- the dry run's estimate ---- */
 
-/* The calibrated preset of m's sizes (every preset is calibrated, with the
- * released rotation); -1 when one differs from each, or with the cayley
- * rotation (twice the values a node: its epochs cost more). */
+/* The calibrated preset of m's sizes and rotation (every preset is
+ * calibrated; the cayley rotation's twice the values a node make its
+ * epochs dearer, hence its presets); -1 when one differs from each. */
 static int calibrated_preset(const pdg_method *m)
 {
     const tcb_pcgrid_method *b = &m->base;
@@ -203,7 +208,7 @@ static int calibrated_preset(const pdg_method *m)
         const pdg_preset *p = &presets[k];
         if (b->points == p->points && b->spec.template_faces == template_budget(p->points) &&
             b->spec.poisson_depth == p->poisson_depth && m->arch.levels == p->levels &&
-            b->recon_points == TCB_PCGRID_RECON_POINTS && m->arch.rotation == TCB_PDG_RELEASED)
+            b->recon_points == TCB_PCGRID_RECON_POINTS && m->arch.rotation == p->rotation)
             return k;
     }
     return -1;
