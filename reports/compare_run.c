@@ -105,8 +105,30 @@ static int ok_cells(const tcb_cell_result *c, int n, const target *t, const char
     return k;
 }
 
-static const char *verdict(const tcb_cmp_metric *m, int metric)
+/* The exact two-sided Wilcoxon's smallest p with n differences is
+ * 2^(1 − n): under 0.05 from n = 6 on, so fewer can never be significant,
+ * and "within noise" would claim a test that could not have been made. */
+#define MIN_TESTABLE 6
+
+/* How many differences are behind metric m's test: clips for Corr, frames
+ * for the reconstruction metrics, else pairs (or sequences). */
+static int n_behind(const tcb_cmp *c, int m)
 {
+    if (c->over_sequences) return c->n;
+    if (m == TCB_M_CORR || m == TCB_M_CORR_MESH) return c->n_clips;
+    if (m >= TCB_M_CDL2) return c->n_frames;
+    return c->n;
+}
+
+static const char *verdict(const tcb_cmp *c, int metric, char *buf, size_t size)
+{
+    const tcb_cmp_metric *m = &c->m[metric];
+    if (isnan(m->p)) return "no difference";
+    int n = n_behind(c, metric);
+    if (n < MIN_TESTABLE) {
+        snprintf(buf, size, "too few to test (%d)", n);
+        return buf;
+    }
     if (!tcb_cmp_significant(m)) return "within noise";
     int a_lower = m->diff < 0;
     return a_lower == tcb_rpt_metrics[metric].lower_is_better ? "A better (significant)" : "B better (significant)";
@@ -154,13 +176,13 @@ static void print_result(FILE *f, const target *t, const tcb_cmp *c)
             fprintf(f, " %10s %10s %10s  %-22s %-9s %s\n", "-", "-", "-", "-", "-", "not compared: a side has no value");
             continue;
         }
-        char iv[64], p[32];
+        char iv[64], p[32], why[48];
         snprintf(iv, sizeof iv, "[%.*f, %.*f]", d + 1, x->lo, d + 1, x->hi);
         if (isnan(x->p)) snprintf(p, sizeof p, "no test");
         else snprintf(p, sizeof p, "%.2g", x->p);
         metric_label(f, tcb_cmp_metric_label(m));
         fprintf(f, " %10.*f %10.*f %10.*f  %-22s %-9s %s\n", d, x->mean_a, d, x->mean_b, d + 1, x->diff, iv, p,
-                isnan(x->p) ? "no difference" : verdict(x, m));
+                verdict(c, m, why, sizeof why));
     }
 }
 
