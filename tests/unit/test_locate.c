@@ -1,8 +1,8 @@
 /* Closest surface points by face and barycentric weights (tcb/locate.h):
  * the Voronoi cases of one triangle, agreement with a brute force over a
- * triangle soup of very unequal sizes (so the centroid pruning is tested
- * where it is tight), carrying points to an affine image of the mesh, and
- * bad input. */
+ * triangle soup of very unequal sizes (so the centroid pruning of several
+ * radius classes is tested where it is tight), exact ties across those
+ * classes, carrying points to an affine image of the mesh, and bad input. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -134,6 +134,31 @@ static void test_matches_brute_force(void **state)
     free(v);
 }
 
+/* Exact ties go to the lowest face index whatever the faces' sizes: four
+ * triangles of sizes 10, 0.01, 1 and 0.1 (four radius classes, the
+ * smallest searched first) share the vertex at the origin, which is the
+ * closest point of each to (−1, −1, −1) at the same squared distance 3. */
+static void test_ties_across_size_classes(void **state)
+{
+    (void)state;
+    static const float size[] = {10, 0.01f, 1, 0.1f};
+    float v[3 + 3 * 2 * 4] = {0, 0, 0};
+    int32_t f[3 * 4];
+    for (int t = 0; t < 4; t++) {
+        float *a = v + 3 + 6 * t, *b = a + 3;
+        a[0] = size[t], a[1] = 0, a[2] = 0.001f * t; /* distinct triangles, all off −x, −y, −z */
+        b[0] = 0, b[1] = size[t], b[2] = 0.001f * t;
+        f[3 * t] = 0, f[3 * t + 1] = 1 + 2 * t, f[3 * t + 2] = 2 + 2 * t;
+    }
+    const float q[3] = {-1, -1, -1};
+    tcb_surface_point loc;
+    float d2;
+    locate_ok(v, 9, f, 4, q, 1, &loc, &d2);
+    assert_int_equal(loc.face, 0);
+    assert_true(d2 == 3.0f);
+    assert_true(loc.bary[0] == 1.0f);
+}
+
 /* Located on a bent tube, carried to an affine image of it: every point
  * lands on the image of its located point. */
 static void test_carry_affine(void **state)
@@ -201,6 +226,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_one_triangle),
         cmocka_unit_test(test_matches_brute_force),
+        cmocka_unit_test(test_ties_across_size_classes),
         cmocka_unit_test(test_carry_affine),
         cmocka_unit_test(test_bad_input),
     };
