@@ -55,6 +55,8 @@ static void rank_sums(signed_abs *v, int n, double *r_plus, double *r_minus, dou
 /* Two-sided exact p of r+ under H0 for n ranks 1..n: counts of subsets of
  * {1..n} by sum, built one rank at a time. Counts stay below 2^50 and are
  * exact in double, so the tails are exact sums divided by 2^n. */
+double tcb_wilcoxon_smallest_p(int n) { return n <= 1 ? 1.0 : ldexp(1.0, 1 - n); }
+
 static double exact_p(int n, double r_plus)
 {
     double count[EXACT_MAX_SUM + 1] = {1.0};

@@ -193,6 +193,9 @@ static void set_style(cairo_t *cr, int s)
     cairo_set_dash(cr, DASHES[s / N_COLOURS], N_DASH_STEPS[s / N_COLOURS], 0);
 }
 
+/* Row k's style; the first (solid, first colour) for a plot of one series. */
+static int row_style(const tcb_chart *c, int k) { return k >= 0 && k < c->n_rows && c->style ? c->style[k] : 0; }
+
 void tcb_chart_series_begin(tcb_chart *c, int k)
 {
     cairo_save(c->cr);
@@ -200,7 +203,7 @@ void tcb_chart_series_begin(tcb_chart *c, int k)
     cairo_rectangle(c->cr, X0, Y0 - 2, X1 - X0, Y1 - Y0 + 2);
     cairo_clip(c->cr);
     cairo_set_line_join(c->cr, CAIRO_LINE_JOIN_ROUND);
-    set_style(c->cr, k >= 0 && k < c->n_rows && c->style ? c->style[k] : 0);
+    set_style(c->cr, row_style(c, k));
 }
 
 void tcb_chart_series_end(tcb_chart *c) { cairo_restore(c->cr); }
@@ -233,7 +236,7 @@ void tcb_chart_legend(tcb_chart *c, const tcb_rpt_block *b, const char *heading,
         const tcb_rpt_row *r = &b->rows[k];
         char label[160];
         if (!strcmp(r->status, "ok")) {
-            set_style(cr, k < c->n_rows && c->style ? c->style[k] : 0);
+            set_style(cr, row_style(c, k));
             cairo_move_to(cr, LEGEND_X, y);
             cairo_line_to(cr, LEGEND_X + 28, y);
             cairo_stroke(cr);

@@ -173,7 +173,7 @@ static int compare_metric(const double *xa, int na, const double *xb, int nb, in
         out->mean_b += mb[p] / pairs;
         ma[p] -= mb[p];
     }
-    out->has = 1;
+    out->has = 1, out->n = pairs;
     out->diff = boot.estimate, out->lo = boot.lo, out->hi = boot.hi;
     rc = wilcoxon_p(ma, pairs, &out->p, err);
     out->p_holm = out->p;

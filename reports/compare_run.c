@@ -8,6 +8,7 @@
 #include "reports/aggregate.h"
 #include "tcb/bootstrap.h"
 #include "tcb/compare.h"
+#include "tcb/wilcoxon.h"
 
 typedef struct target {
     const char *dataset, *sequence, *a, *b;
@@ -105,28 +106,15 @@ static int ok_cells(const tcb_cell_result *c, int n, const target *t, const char
     return k;
 }
 
-/* The exact two-sided Wilcoxon's smallest p with n differences is
- * 2^(1 − n): under 0.05 from n = 6 on, so fewer can never be significant,
- * and "within noise" would claim a test that could not have been made. */
-#define MIN_TESTABLE 6
-
-/* How many differences are behind metric m's test: clips for Corr, frames
- * for the reconstruction metrics, else pairs (or sequences). */
-static int n_behind(const tcb_cmp *c, int m)
-{
-    if (c->over_sequences) return c->n;
-    if (m == TCB_M_CORR || m == TCB_M_CORR_MESH) return c->n_clips;
-    if (m >= TCB_M_CDL2) return c->n_frames;
-    return c->n;
-}
-
+/* Too few differences (the one or two clips behind a Corr) can never be
+ * significant: "within noise" would claim a test that could not have been
+ * made. */
 static const char *verdict(const tcb_cmp *c, int metric, char *buf, size_t size)
 {
     const tcb_cmp_metric *m = &c->m[metric];
     if (isnan(m->p)) return "no difference";
-    int n = n_behind(c, metric);
-    if (n < MIN_TESTABLE) {
-        snprintf(buf, size, "too few to test (%d)", n);
+    if (tcb_wilcoxon_smallest_p(m->n) >= TCB_CMP_ALPHA) {
+        snprintf(buf, size, "too few to test (%d)", m->n);
         return buf;
     }
     if (!tcb_cmp_significant(m)) return "within noise";

@@ -72,6 +72,7 @@ typedef struct tcb_cmp_metric {
     double diff, lo, hi;     /* A − B and its 95 % bootstrap interval */
     double p;                /* Wilcoxon, two-sided; NaN: no test (every difference 0) */
     double p_holm;           /* Holm-adjusted within the report's family; = p otherwise */
+    int n;                   /* differences behind the test: pairs, clips, frames or sequences */
 } tcb_cmp_metric;
 
 typedef struct tcb_cmp {

@@ -37,6 +37,11 @@ typedef struct tcb_wilcoxon_result {
  * way no test was made, and the caller shows it as such. */
 int tcb_wilcoxon(const double *d, int n, tcb_wilcoxon_result *out, tcb_error *err);
 
+/* The smallest two-sided p the exact test gives n differences (all of one
+ * sign): 2^(1 − n), 1 for n ≤ 1. Below 0.05 only from n = 6 on: fewer
+ * differences can never be significant at that level. */
+double tcb_wilcoxon_smallest_p(int n);
+
 /* Holm (1979) step-down adjustment of m p-values, in place of a family-wise
  * error rate: with p sorted ascending, adj_(i) = max_{j ≤ i} min(1, (m − j)·p_(j))
  * (j from 0). adj[k] belongs to p[k]; adj may alias p. Equal to R's

@@ -188,11 +188,29 @@ static void test_holm_rejects_bad_p(void **state)
     assert_int_equal(tcb_holm_adjust(p, 2, adj, &err), TCB_ERR_INPUT);
 }
 
+/* The smallest p is the exact test's p of n differences of one sign, and
+ * first falls under 0.05 at n = 6. */
+static void test_smallest_p(void **state)
+{
+    (void)state;
+    double d[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+    for (int n = 1; n <= 8; n++) {
+        tcb_wilcoxon_result w;
+        tcb_error err = {0};
+        assert_int_equal(tcb_wilcoxon(d, n, &w, &err), TCB_OK);
+        assert_true(w.method == TCB_WILCOXON_EXACT);
+        assert_true(tcb_wilcoxon_smallest_p(n) == w.p);
+    }
+    assert_true(tcb_wilcoxon_smallest_p(5) >= 0.05 && tcb_wilcoxon_smallest_p(6) < 0.05);
+    assert_true(tcb_wilcoxon_smallest_p(0) == 1.0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_exact_matches_enumeration),
         cmocka_unit_test(test_exact_by_hand),
+        cmocka_unit_test(test_smallest_p),
         cmocka_unit_test(test_exact_with_ties),
         cmocka_unit_test(test_zero_switches_to_normal),
         cmocka_unit_test(test_normal_tie_correction),
