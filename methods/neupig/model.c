@@ -78,15 +78,6 @@ void tcb_neupig_params_init(const tcb_neupig_model *m, float *params, tcb_rng *r
     tcb_linear_init_uniform(&l[1], rng);
 }
 
-/* Activations of one forward pass, kept for the backward. */
-typedef struct acts {
-    int rows;                 /* T·nv */
-    float *feat_p, *feat_n;   /* [nv][F], [nv][Fn] after tanh */
-    float *x0, *h1, *h2, *o;  /* MLP input [rows][in], hidden [rows][H] ×2, output [rows][7] */
-    float *values;            /* one grid's values, the largest grid's size */
-    double *scratch;          /* the Sobolev solve's */
-} acts;
-
 static size_t largest_grid(const tcb_neupig_model *m)
 {
     size_t n = 0;
@@ -95,30 +86,45 @@ static size_t largest_grid(const tcb_neupig_model *m)
     return n;
 }
 
-static void acts_free(acts *w)
+void tcb_neupig_work_free(tcb_neupig_work *w)
 {
     free(w->feat_p), free(w->feat_n), free(w->x0), free(w->h1), free(w->h2), free(w->o);
-    free(w->values), free(w->scratch);
+    free(w->X), free(w->dX), free(w->dout), free(w->dh), free(w->dx0);
+    free(w->dfeat_p), free(w->dfeat_n), free(w->values), free(w->scratch), free(w->cd);
+    memset(w, 0, sizeof *w);
 }
 
-static int acts_alloc(const tcb_neupig_model *m, const tcb_neupig_problem *p, acts *w, tcb_error *err)
+int tcb_neupig_work_init(tcb_neupig_work *w, const tcb_neupig_model *m, const tcb_neupig_problem *p,
+                         tcb_error *err)
 {
     memset(w, 0, sizeof *w);
-    if (p->T < 2 || p->nv < 1 || p->key < 0 || p->key >= p->T)
-        return tcb_fail(err, TCB_ERR_INPUT, "neupig: %d frames, %d template vertices, keyframe %d",
-                        p->T, p->nv, p->key);
-    size_t rows = (size_t)p->T * (size_t)p->nv, H = (size_t)m->a.hidden, grid = largest_grid(m);
-    w->rows = (int)rows;
-    w->feat_p = malloc((size_t)p->nv * (size_t)m->a.features * sizeof(float));
-    w->feat_n = malloc((size_t)p->nv * (size_t)m->a.normal_features * sizeof(float));
-    w->x0 = malloc(rows * (size_t)mlp_in(&m->a) * sizeof(float));
+    if (p->T < 2 || p->T > TCB_NEUPIG_MAX_FRAMES || p->nv < 1 || p->key < 0 || p->key >= p->T)
+        return tcb_fail(err, TCB_ERR_INPUT, "neupig: %d frames (2 to %d), %d template vertices, keyframe %d",
+                        p->T, TCB_NEUPIG_MAX_FRAMES, p->nv, p->key);
+    size_t nv = (size_t)p->nv, rows = (size_t)p->T * nv, H = (size_t)m->a.hidden;
+    size_t F = (size_t)m->a.features, Fn = (size_t)m->a.normal_features, in = (size_t)mlp_in(&m->a);
+    size_t grid = largest_grid(m);
+    w->T = p->T, w->nv = p->nv, w->rows = (int)rows;
+    w->feat_p = malloc(nv * F * sizeof(float));
+    w->feat_n = malloc(nv * Fn * sizeof(float));
+    w->x0 = malloc(rows * in * sizeof(float));
     w->h1 = malloc(rows * H * sizeof(float));
     w->h2 = malloc(rows * H * sizeof(float));
     w->o = malloc(rows * TCB_RIGID_OUT * sizeof(float));
+    w->X = malloc(rows * 3 * sizeof(float));
+    w->dX = malloc(rows * 3 * sizeof(float));
+    w->dout = malloc(rows * TCB_RIGID_OUT * sizeof(float));
+    w->dh = malloc(rows * H * sizeof(float));
+    w->dx0 = malloc(rows * in * sizeof(float));
+    w->dfeat_p = malloc(nv * F * sizeof(float));
+    w->dfeat_n = malloc(nv * Fn * sizeof(float));
     w->values = malloc(grid * sizeof(float));
     w->scratch = malloc(grid * sizeof(double));
-    if (!w->feat_p || !w->feat_n || !w->x0 || !w->h1 || !w->h2 || !w->o || !w->values || !w->scratch) {
-        acts_free(w);
+    w->cd = malloc((size_t)p->T * sizeof(double));
+    if (!w->feat_p || !w->feat_n || !w->x0 || !w->h1 || !w->h2 || !w->o || !w->X || !w->dX ||
+        !w->dout || !w->dh || !w->dx0 || !w->dfeat_p || !w->dfeat_n || !w->values || !w->scratch ||
+        !w->cd) {
+        tcb_neupig_work_free(w);
         return tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory for %d frames × %d vertices",
                         p->T, p->nv);
     }
@@ -128,7 +134,7 @@ static int acts_alloc(const tcb_neupig_model *m, const tcb_neupig_problem *p, ac
 /* feat [nv][width] = tanh(Σ over the grids of one kind of their samples at
  * pts, position levels averaged). */
 static void grid_features(const tcb_neupig_model *m, const float *params, int first, int last,
-                          const float *pts, int nv, acts *w, float *feat)
+                          const float *pts, int nv, tcb_neupig_work *w, float *feat)
 {
     int width = m->width[first];
     memset(feat, 0, (size_t)nv * (size_t)width * sizeof *feat);
@@ -141,7 +147,7 @@ static void grid_features(const tcb_neupig_model *m, const float *params, int fi
 }
 
 static void forward(const tcb_neupig_model *m, const float *params, const tcb_neupig_problem *p,
-                    acts *w, float *X)
+                    tcb_neupig_work *w, float *X)
 {
     const tcb_neupig_arch *a = &m->a;
     int nv = p->nv, in = mlp_in(a), F = a->features, Fn = a->normal_features;
@@ -171,10 +177,10 @@ static void forward(const tcb_neupig_model *m, const float *params, const tcb_ne
 int tcb_neupig_deform(const tcb_neupig_model *m, const float *params, const tcb_neupig_problem *p,
                       float *X, tcb_error *err)
 {
-    acts w;
-    int rc = acts_alloc(m, p, &w, err);
+    tcb_neupig_work w;
+    int rc = tcb_neupig_work_init(&w, m, p, err);
     if (!rc) forward(m, params, p, &w, X);
-    acts_free(&w);
+    tcb_neupig_work_free(&w);
     return rc;
 }
 
@@ -184,8 +190,7 @@ static int loss_backward(const tcb_neupig_model *m, const tcb_neupig_problem *p,
                          float *dX, tcb_error *err)
 {
     size_t frame = (size_t)p->nv * 3;
-    double conf[4096];
-    if (p->T > 4096) return tcb_fail(err, TCB_ERR_INPUT, "neupig: %d frames, at most 4096", p->T);
+    double conf[TCB_NEUPIG_MAX_FRAMES];
     for (int t = 0; t < p->T; t++) {
         int rc = tcb_robust_chamfer(X + t * frame, p->nv, p->points[t], p->n_points[t],
                                     p->points_index[t], m->a.welsch_alpha, &cd[t], dX + t * frame, err);
@@ -205,7 +210,7 @@ static int loss_backward(const tcb_neupig_model *m, const tcb_neupig_problem *p,
 
 /* The grids' gradients from dfeat (∂ℓ/∂ of the tanh outputs, overwritten). */
 static void grid_backward(const tcb_neupig_model *m, int first, int last, const float *pts, int nv,
-                          const float *feat, float *dfeat, acts *w, float *grads)
+                          const float *feat, float *dfeat, tcb_neupig_work *w, float *grads)
 {
     int width = m->width[first];
     for (size_t i = 0; i < (size_t)nv * (size_t)width; i++) dfeat[i] *= 1.0f - feat[i] * feat[i];
@@ -233,61 +238,39 @@ static void feature_grads(const tcb_neupig_model *m, const tcb_neupig_problem *p
         }
 }
 
-/* Back through the MLP and the grids, from dX; w's buffers are reused
- * once their values are spent. */
-static int backward(const tcb_neupig_model *m, const float *params, const tcb_neupig_problem *p,
-                    acts *w, const float *dX, float *grads, tcb_error *err)
+/* Back through the MLP and the grids, from w->dX; w's activations are
+ * overwritten once their values are spent. */
+static void backward(const tcb_neupig_model *m, const float *params, const tcb_neupig_problem *p,
+                     tcb_neupig_work *w, float *grads)
 {
     const tcb_neupig_arch *a = &m->a;
     int in = mlp_in(a);
     int64_t hn = (int64_t)w->rows * a->hidden;
-    float *dout = malloc((size_t)w->rows * TCB_RIGID_OUT * sizeof *dout);
-    float *dh = malloc((size_t)hn * sizeof *dh);
-    float *dx0 = malloc((size_t)w->rows * (size_t)in * sizeof *dx0);
-    float *dfeat_p = malloc((size_t)p->nv * a->features * sizeof *dfeat_p);
-    float *dfeat_n = malloc((size_t)p->nv * a->normal_features * sizeof *dfeat_n);
-    int rc = dout && dh && dx0 && dfeat_p && dfeat_n
-                 ? TCB_OK
-                 : tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory for the backward pass");
-    if (!rc) {
-        tcb_linear l[3], g[3];
-        tcb_neupig_mlp_view(m, (float *)params, l);
-        tcb_neupig_mlp_view(m, grads, g);
-        tcb_rigid_backward(dout, dX, w->o, p->verts, w->rows, p->nv);
-        tcb_linear_backward(dh, g[2].W, g[2].b, dout, w->h2, l[2].W, w->rows, 0, a->hidden, TCB_RIGID_OUT);
-        tcb_leaky_relu_backward(dh, dh, w->h2, hn, TCB_NEUPIG_LEAKY_SLOPE);
-        tcb_linear_backward(w->h2, g[1].W, g[1].b, dh, w->h1, l[1].W, w->rows, 0, a->hidden, a->hidden);
-        tcb_leaky_relu_backward(w->h2, w->h2, w->h1, hn, TCB_NEUPIG_LEAKY_SLOPE);
-        tcb_linear_backward(dx0, g[0].W, g[0].b, w->h2, w->x0, l[0].W, w->rows, 0, in, a->hidden);
-        feature_grads(m, p, dx0, dfeat_p, dfeat_n);
-        grid_backward(m, 0, a->levels, p->verts, p->nv, w->feat_p, dfeat_p, w, grads);
-        grid_backward(m, a->levels, m->grids, p->normals, p->nv, w->feat_n, dfeat_n, w, grads);
-    }
-    free(dout), free(dh), free(dx0), free(dfeat_p), free(dfeat_n);
-    return rc;
+    tcb_linear l[3], g[3];
+    tcb_neupig_mlp_view(m, (float *)params, l);
+    tcb_neupig_mlp_view(m, grads, g);
+    tcb_rigid_backward(w->dout, w->dX, w->o, p->verts, w->rows, p->nv);
+    tcb_linear_backward(w->dh, g[2].W, g[2].b, w->dout, w->h2, l[2].W, w->rows, 0, a->hidden, TCB_RIGID_OUT);
+    tcb_leaky_relu_backward(w->dh, w->dh, w->h2, hn, TCB_NEUPIG_LEAKY_SLOPE);
+    tcb_linear_backward(w->h2, g[1].W, g[1].b, w->dh, w->h1, l[1].W, w->rows, 0, a->hidden, a->hidden);
+    tcb_leaky_relu_backward(w->h2, w->h2, w->h1, hn, TCB_NEUPIG_LEAKY_SLOPE);
+    tcb_linear_backward(w->dx0, g[0].W, g[0].b, w->h2, w->x0, l[0].W, w->rows, 0, in, a->hidden);
+    feature_grads(m, p, w->dx0, w->dfeat_p, w->dfeat_n);
+    grid_backward(m, 0, a->levels, p->verts, p->nv, w->feat_p, w->dfeat_p, w, grads);
+    grid_backward(m, a->levels, m->grids, p->normals, p->nv, w->feat_n, w->dfeat_n, w, grads);
 }
 
 int tcb_neupig_loss_grad(const tcb_neupig_model *m, const float *params,
-                         const tcb_neupig_problem *p, long long epoch, long long epochs,
-                         tcb_neupig_loss *out, double *cd, float *grads, tcb_error *err)
+                         const tcb_neupig_problem *p, tcb_neupig_work *w, long long epoch,
+                         long long epochs, tcb_neupig_loss *out, float *grads, tcb_error *err)
 {
-    acts w;
-    int rc = acts_alloc(m, p, &w, err);
+    if (w->T != p->T || w->nv != p->nv)
+        return tcb_fail(err, TCB_ERR_INTERNAL, "neupig: work for %d frames × %d vertices, problem %d × %d",
+                        w->T, w->nv, p->T, p->nv);
+    forward(m, params, p, w, w->X);
+    int rc = loss_backward(m, p, w->X, epoch, epochs, out, w->cd, w->dX, err);
     if (rc) return rc;
-    size_t nx = (size_t)p->T * (size_t)p->nv * 3;
-    float *X = malloc(nx * sizeof *X), *dX = malloc(nx * sizeof *dX);
-    double *cd_own = cd ? NULL : malloc((size_t)p->T * sizeof *cd_own);
-    if (!X || !dX || (!cd && !cd_own))
-        rc = tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory for %d frames", p->T);
-    if (!rc) {
-        forward(m, params, p, &w, X);
-        rc = loss_backward(m, p, X, epoch, epochs, out, cd ? cd : cd_own, dX, err);
-    }
-    if (!rc) {
-        memset(grads, 0, m->n_params * sizeof *grads);
-        rc = backward(m, params, p, &w, dX, grads, err);
-    }
-    free(X), free(dX), free(cd_own);
-    acts_free(&w);
-    return rc;
+    memset(grads, 0, m->n_params * sizeof *grads);
+    backward(m, params, p, w, grads);
+    return TCB_OK;
 }

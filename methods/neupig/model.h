@@ -35,6 +35,7 @@
 #include "tcb/rng.h"
 
 #define TCB_NEUPIG_MAX_LEVELS 16
+#define TCB_NEUPIG_MAX_FRAMES 4096 /* the per-frame confidences sit on the stack */
 #define TCB_NEUPIG_LEAKY_SLOPE 0.01f
 
 typedef struct tcb_neupig_arch {
@@ -88,14 +89,35 @@ typedef struct tcb_neupig_loss {
     double total, chamfer, edge;      /* total = chamfer + edge */
 } tcb_neupig_loss;
 
+/* The buffers of one loss-and-gradient evaluation at a problem's sizes,
+ * rows = T·nv: allocated once, so that an epoch allocates nothing (the
+ * paper preset's activations are ~0.4 GB; mapped afresh each epoch, their
+ * page faults were a third of the step). */
+typedef struct tcb_neupig_work {
+    int T, nv, rows;
+    float *feat_p, *feat_n;       /* [nv][F], [nv][Fn] after tanh */
+    float *x0, *h1, *h2, *o;      /* MLP input [rows][in], hidden [rows][H] ×2, output [rows][7] */
+    float *X, *dX;                /* [rows][3]: the moved template, the loss's gradient in it */
+    float *dout, *dh, *dx0;       /* the backward's [rows][7], [rows][H], [rows][in] */
+    float *dfeat_p, *dfeat_n;     /* [nv][F], [nv][Fn] */
+    float *values;                /* one grid's values, the largest grid's size */
+    double *scratch;              /* the Sobolev solve's, as large */
+    double *cd;                   /* [T] each frame's CD */
+} tcb_neupig_work;
+
+int tcb_neupig_work_init(tcb_neupig_work *w, const tcb_neupig_model *m, const tcb_neupig_problem *p,
+                         tcb_error *err);
+void tcb_neupig_work_free(tcb_neupig_work *w);
+
 /* X [T][nv][3]: the template moved into every frame. */
 int tcb_neupig_deform(const tcb_neupig_model *m, const float *params, const tcb_neupig_problem *p,
                       float *X, tcb_error *err);
 
 /* The loss at (epoch of epochs) and its gradient, grads [n_params]
- * (overwritten); cd [T] (may be NULL) receives each frame's CD. */
+ * (overwritten), through w (made for p's sizes); each frame's CD is left
+ * in w->cd. */
 int tcb_neupig_loss_grad(const tcb_neupig_model *m, const float *params,
-                         const tcb_neupig_problem *p, long long epoch, long long epochs,
-                         tcb_neupig_loss *out, double *cd, float *grads, tcb_error *err);
+                         const tcb_neupig_problem *p, tcb_neupig_work *w, long long epoch,
+                         long long epochs, tcb_neupig_loss *out, float *grads, tcb_error *err);
 
 #endif

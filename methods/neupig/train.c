@@ -25,6 +25,7 @@ int tcb_neupig_trainer_init(tcb_neupig_trainer *t, const tcb_neupig_arch *a,
     t->grads = malloc(n * sizeof *t->grads);
     rc = t->params && t->grads ? tcb_adam_init(&t->adam, n, err)
                                : tcb_fail(err, TCB_ERR_NOMEM, "neupig: out of memory for %zu parameters", n);
+    if (!rc) rc = tcb_neupig_work_init(&t->work, &t->model, p, err);
     if (rc) {
         tcb_neupig_trainer_free(t);
         return rc;
@@ -43,6 +44,7 @@ void tcb_neupig_trainer_free(tcb_neupig_trainer *t)
 {
     tcb_neupig_model_free(&t->model);
     tcb_adam_free(&t->adam);
+    tcb_neupig_work_free(&t->work);
     free(t->params);
     free(t->grads);
     memset(t, 0, sizeof *t);
@@ -50,8 +52,8 @@ void tcb_neupig_trainer_free(tcb_neupig_trainer *t)
 
 int tcb_neupig_train_step(tcb_neupig_trainer *t, double *loss, tcb_error *err)
 {
-    int rc = tcb_neupig_loss_grad(&t->model, t->params, t->problem, t->it, t->sched.epochs, &t->last,
-                                  NULL, t->grads, err);
+    int rc = tcb_neupig_loss_grad(&t->model, t->params, t->problem, &t->work, t->it, t->sched.epochs,
+                                  &t->last, t->grads, err);
     if (!rc) {
         *loss = t->last.total;
         rc = isfinite(*loss) ? tcb_train_guard("neupig", t->it, *loss, t->grads, t->model.n_params,

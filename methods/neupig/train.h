@@ -24,6 +24,7 @@ typedef struct tcb_neupig_trainer {
     tcb_neupig_schedule sched;
     const tcb_neupig_problem *problem; /* the caller's, for the trainer's life */
     float *params, *grads;             /* [model.n_params] */
+    tcb_neupig_work work;              /* the epoch's buffers, for the problem's sizes */
     tcb_adam adam;
     size_t bounds[TCB_NEUPIG_MAX_LEVELS + 3]; /* Adam's groups: the grids, then the MLP */
     double lrs[TCB_NEUPIG_MAX_LEVELS + 2];

@@ -84,18 +84,22 @@ int main(int argc, char **argv)
     }
     float *vf = as_float(verts, nv3), *nf = as_float(normals, nn3), *lf = as_float(len, ne);
     float *pf = as_float(params, np), *grads = malloc(np * sizeof *grads);
-    double *cd = malloc((size_t)T * sizeof *cd);
     tcb_neupig_problem prob = {(int)(nv3 / 3), vf, nf, (int)ne, e32, lf, T,
                                (const float *const *)pts, n_pts, (const tcb_nn *const *)idx, v[9]};
     tcb_neupig_loss loss;
-    if (tcb_neupig_loss_grad(&m, pf, &prob, v[10], v[11], &loss, cd, grads, &err)) goto fail;
+    tcb_neupig_work work;
+    if (tcb_neupig_work_init(&work, &m, &prob, &err) ||
+        tcb_neupig_loss_grad(&m, pf, &prob, &work, v[10], v[11], &loss, grads, &err))
+        goto fail;
+    const double *cd = work.cd;
     double l[3] = {loss.total, loss.chamfer, loss.edge};
     if (save(dir, "c_loss.npy", TCB_NPY_F8, 3, l, &err) || save(dir, "c_cd.npy", TCB_NPY_F8, (uint64_t)T, cd, &err) ||
         save(dir, "c_grads.npy", TCB_NPY_F4, np, grads, &err))
         goto fail;
     for (int t = 0; t < T; t++) free(pts[t]), tcb_nn_free(idx[t]);
     free(verts), free(normals), free(edges), free(len), free(params), free(e32);
-    free(vf), free(nf), free(lf), free(pf), free(grads), free(cd);
+    free(vf), free(nf), free(lf), free(pf), free(grads);
+    tcb_neupig_work_free(&work);
     tcb_neupig_model_free(&m);
     return 0;
 fail: /* a test helper: on failure the process ends at once */
