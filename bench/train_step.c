@@ -74,7 +74,11 @@
  *
  * Targets (issue 41): every paper-scale step ≥ 5× PyTorch at 1 thread,
  * the GEMM-dominated steps at ≥ 60 % of the sgemm rate on their own
- * dominant product (%shp). Timings only; nothing is asserted.
+ * dominant product (%shp). The column `ceiling` bounds the first: the
+ * peer's time over the counted FLOPs at the 2048³ rate, the torch/C of a
+ * C step that did nothing but its GEMMs at the machine's best rate (a step
+ * passes it only by running its GEMMs faster than OpenBLAS runs 2048³, or
+ * by doing fewer FLOPs than counted). Timings only; nothing is asserted.
  *
  * usage: bench_train_step [--iters N] [--threads T] [--preset paper|cpu|all]
  *                         [--method NAME] [--no-torch]
@@ -348,10 +352,12 @@ static void print_header(const options *o)
            "pdg (one epoch after the warm-up: every transition and chain; tcb_pdg_train_step): not counted (-).\n"
            "Losses, nearest neighbours and Adam not counted.\n"
            "This machine's sgemm (OpenBLAS, %d thread(s), measured now): %.1f GFLOP/s on 2048^3;\n"
-           "  %%sq: the step's GFLOP/s over it, %%shp: over sgemm on the step's dominant product (shape m x n x k).\n",
+           "  %%sq: the step's GFLOP/s over it, %%shp: over sgemm on the step's dominant product (shape m x n x k);\n"
+           "  ceiling: the torch/C a step of only its counted FLOPs at the 2048^3 rate would reach.\n",
            P, N, o->threads, o->sgemm_square);
-    printf("%-6s %-9s %8s %9s %8s %5s %5s %10s %8s %9s %9s  %s\n", "preset", "method", "GFLOP/it", "C ms/it",
-           "GFLOP/s", "%sq", "%shp", "torch ms", "torch/C", "C RSS MiB", "torch MiB", "dominant product (sgemm GFLOP/s)");
+    printf("%-6s %-9s %8s %9s %8s %5s %5s %10s %8s %7s %9s %9s  %s\n", "preset", "method", "GFLOP/it", "C ms/it",
+           "GFLOP/s", "%sq", "%shp", "torch ms", "torch/C", "ceiling", "C RSS MiB", "torch MiB",
+           "dominant product (sgemm GFLOP/s)");
 }
 
 /* One row: the C figures and the peer's (rc 0), or n/a; gflop < 0: not
@@ -369,8 +375,13 @@ static void print_row(options *o, const char *preset, const char *method, double
                100 * gfs / o->sgemm_square, 100 * gfs / shape);
         snprintf(o->dominant, sizeof o->dominant, "%dx%dx%d (%.1f)", dominant.m, dominant.n, dominant.k, shape);
     }
-    if (rc == 0) printf(" %10.1f %8.2f %9.0f %9.0f", tms, tms / ms, c_rss, rss / 1024.0);
-    else printf(" %10s %8s %9.0f %9s", "n/a", "n/a", c_rss, "n/a");
+    if (rc == 0 && gflop >= 0)
+        printf(" %10.1f %8.2f %7.2f %9.0f %9.0f", tms, tms / ms, tms / (gflop / o->sgemm_square * 1e3), c_rss,
+               rss / 1024.0);
+    else if (rc == 0)
+        printf(" %10.1f %8.2f %7s %9.0f %9.0f", tms, tms / ms, "-", c_rss, rss / 1024.0);
+    else
+        printf(" %10s %8s %7s %9.0f %9s", "n/a", "n/a", "n/a", c_rss, "n/a");
     printf("  %s\n", gflop < 0 ? "-" : o->dominant);
     if (rc == PEER_SKIPPED && o->torch) {
         printf("PyTorch peer: unavailable (install python3-torch)\n");
