@@ -10,6 +10,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "methods/neupig/train.h"
@@ -110,6 +111,41 @@ static void test_loss_falls(void **state)
     release(&f);
 }
 
+/* An epoch's buffers are reused: two evaluations through one work equal
+ * one through a fresh work (nothing accumulates across calls), and a work
+ * made for other sizes is refused, not overrun. */
+static void test_work_reused_and_checked(void **state)
+{
+    (void)state;
+    fixture f;
+    build(&f);
+    tcb_neupig_arch a = small_arch();
+    tcb_neupig_trainer t;
+    start(&t, &a, &f);
+    steps(&t, 3, &(double){0}); /* parameters away from the start */
+    size_t n = t.model.n_params;
+    float *g1 = malloc(n * sizeof *g1), *g2 = malloc(n * sizeof *g2);
+    tcb_error err = {0};
+    tcb_neupig_loss l1, l2;
+    tcb_neupig_work fresh;
+    assert_int_equal(tcb_neupig_work_init(&fresh, &t.model, &f.problem, &err), TCB_OK);
+    assert_int_equal(tcb_neupig_loss_grad(&t.model, t.params, &f.problem, &t.work, 3, 200, &l1, g1, &err), TCB_OK);
+    assert_int_equal(tcb_neupig_loss_grad(&t.model, t.params, &f.problem, &t.work, 3, 200, &l1, g1, &err), TCB_OK);
+    assert_int_equal(tcb_neupig_loss_grad(&t.model, t.params, &f.problem, &fresh, 3, 200, &l2, g2, &err), TCB_OK);
+    assert_true(l1.total == l2.total && l1.chamfer == l2.chamfer && l1.edge == l2.edge);
+    assert_memory_equal(g1, g2, n * sizeof *g1);
+    assert_memory_equal(t.work.cd, fresh.cd, (size_t)T * sizeof *fresh.cd);
+    tcb_neupig_problem fewer = f.problem;
+    fewer.T = T - 1;
+    assert_int_equal(tcb_neupig_loss_grad(&t.model, t.params, &fewer, &fresh, 3, 200, &l2, g2, &err),
+                     TCB_ERR_INTERNAL);
+    assert_non_null(strstr(err.msg, "work for"));
+    tcb_neupig_work_free(&fresh);
+    free(g1), free(g2);
+    tcb_neupig_trainer_free(&t);
+    release(&f);
+}
+
 static void test_resume_bit_identical(void **state)
 {
     const char *dir = *state;
@@ -148,6 +184,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_loss_falls),
+        cmocka_unit_test(test_work_reused_and_checked),
         cmocka_unit_test_setup_teardown(test_resume_bit_identical, tu_setup_tmpdir, tu_teardown_tmpdir)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
