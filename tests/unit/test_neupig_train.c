@@ -93,14 +93,20 @@ static void steps(tcb_neupig_trainer *t, int n, double *loss)
         if (tcb_neupig_train_step(t, loss, &err)) fail_msg("%s", err.msg);
 }
 
+/* The fixture built and a trainer of the small architecture started on it. */
+static void begin(fixture *f, tcb_neupig_trainer *t)
+{
+    build(f);
+    tcb_neupig_arch a = small_arch();
+    start(t, &a, f);
+}
+
 static void test_loss_falls(void **state)
 {
     (void)state;
     fixture f;
-    build(&f);
-    tcb_neupig_arch a = small_arch();
     tcb_neupig_trainer t;
-    start(&t, &a, &f);
+    begin(&f, &t);
     double first, last;
     steps(&t, 1, &first);
     steps(&t, 199, &last);
@@ -118,10 +124,8 @@ static void test_work_reused_and_checked(void **state)
 {
     (void)state;
     fixture f;
-    build(&f);
-    tcb_neupig_arch a = small_arch();
     tcb_neupig_trainer t;
-    start(&t, &a, &f);
+    begin(&f, &t);
     steps(&t, 3, &(double){0}); /* parameters away from the start */
     size_t n = t.model.n_params;
     float *g1 = malloc(n * sizeof *g1), *g2 = malloc(n * sizeof *g2);
