@@ -174,13 +174,19 @@ static void forward(const tcb_neupig_model *m, const float *params, const tcb_ne
     tcb_rigid_forward(X, w->o, p->verts, w->rows, nv);
 }
 
-int tcb_neupig_deform(const tcb_neupig_model *m, const float *params, const tcb_neupig_problem *p,
-                      float *X, tcb_error *err)
+/* w made for p's sizes (a work outlives its problem only by mistake). */
+static int work_fits(const tcb_neupig_work *w, const tcb_neupig_problem *p, tcb_error *err)
 {
-    tcb_neupig_work w;
-    int rc = tcb_neupig_work_init(&w, m, p, err);
-    if (!rc) forward(m, params, p, &w, X);
-    tcb_neupig_work_free(&w);
+    if (w->T == p->T && w->nv == p->nv) return TCB_OK;
+    return tcb_fail(err, TCB_ERR_INTERNAL, "neupig: work for %d frames × %d vertices, problem %d × %d", w->T,
+                    w->nv, p->T, p->nv);
+}
+
+int tcb_neupig_deform(const tcb_neupig_model *m, const float *params, const tcb_neupig_problem *p,
+                      tcb_neupig_work *w, float *X, tcb_error *err)
+{
+    int rc = work_fits(w, p, err);
+    if (!rc) forward(m, params, p, w, X);
     return rc;
 }
 
@@ -264,11 +270,10 @@ int tcb_neupig_loss_grad(const tcb_neupig_model *m, const float *params,
                          const tcb_neupig_problem *p, tcb_neupig_work *w, long long epoch,
                          long long epochs, tcb_neupig_loss *out, float *grads, tcb_error *err)
 {
-    if (w->T != p->T || w->nv != p->nv)
-        return tcb_fail(err, TCB_ERR_INTERNAL, "neupig: work for %d frames × %d vertices, problem %d × %d",
-                        w->T, w->nv, p->T, p->nv);
+    int rc = work_fits(w, p, err);
+    if (rc) return rc;
     forward(m, params, p, w, w->X);
-    int rc = loss_backward(m, p, w->X, epoch, epochs, out, w->cd, w->dX, err);
+    rc = loss_backward(m, p, w->X, epoch, epochs, out, w->cd, w->dX, err);
     if (rc) return rc;
     memset(grads, 0, m->n_params * sizeof *grads);
     backward(m, params, p, w, grads);

@@ -109,9 +109,10 @@ int tcb_neupig_work_init(tcb_neupig_work *w, const tcb_neupig_model *m, const tc
                          tcb_error *err);
 void tcb_neupig_work_free(tcb_neupig_work *w);
 
-/* X [T][nv][3]: the template moved into every frame. */
+/* X [T][nv][3]: the template moved into every frame, through w (made for
+ * p's sizes: the trainer's, so a read-out allocates nothing either). */
 int tcb_neupig_deform(const tcb_neupig_model *m, const float *params, const tcb_neupig_problem *p,
-                      float *X, tcb_error *err);
+                      tcb_neupig_work *w, float *X, tcb_error *err);
 
 /* The loss at (epoch of epochs) and its gradient, grads [n_params]
  * (overwritten), through w (made for p's sizes); each frame's CD is left

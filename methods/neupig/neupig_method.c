@@ -173,8 +173,8 @@ static float *params(void *t_, size_t *n)
 /* The template deformed into every frame. */
 static int frames(void *t_, float *X, tcb_error *err)
 {
-    const tcb_neupig_trainer *t = t_;
-    return tcb_neupig_deform(&t->model, t->params, t->problem, X, err);
+    tcb_neupig_trainer *t = t_;
+    return tcb_neupig_deform(&t->model, t->params, t->problem, &t->work, X, err);
 }
 
 /* The model file's sizes: the architecture's and the template's. */
