@@ -20,6 +20,7 @@
 #define TCB_NEURAL_BATCHNORM_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #define TCB_BN_EPS 1e-5
 #define TCB_BN_MAX_C 4096 /* channels of one layer */
@@ -49,6 +50,25 @@ void tcb_batchnorm_reset_running(const tcb_batchnorm *bn);
  * mu, var2 [C] (for update_running). */
 void tcb_batchnorm_forward_train(const tcb_batchnorm *bn, float *y, float *xhat, float *rstd, float *mu,
                                  float *var2, const float *x, int n, int relu);
+
+/* Training-mode batch norm without ReLU followed by the max over each of
+ * nb sets of n rows (PointNet's last layer and its global pool), without
+ * writing BN(x) or x̂: x [nb·n][C] → g [nb][C], arg [nb][C] (the row
+ * within its set), bit for bit what forward_train and tcb_maxpool_forward
+ * give. Keeps rstd, mu, var2 [C] as forward_train and mlo [C], the mean's
+ * low float part; the backward recomputes x̂ from x, which the caller
+ * keeps. Two passes over x instead of forward_train's and the pool's four
+ * (and the backward two instead of six): at PointNet's 1024 channels
+ * these passes are the encoder's memory traffic. */
+void tcb_batchnorm_maxpool_forward_train(const tcb_batchnorm *bn, float *g, int32_t *arg, float *rstd, float *mu,
+                                         float *mlo, float *var2, const float *x, int nb, int n);
+
+/* Its backward: dx [nb·n][C] from dg [nb][C] = ∂L/∂g, grad->gamma and
+ * grad->beta [C] accumulated; equal bit for bit to scattering dg to the
+ * max rows and tcb_batchnorm_backward with the stored x̂. */
+void tcb_batchnorm_maxpool_backward(const tcb_batchnorm *bn, const tcb_batchnorm *grad, float *dx, const float *dg,
+                                    const int32_t *arg, const float *x, const float *rstd, const float *mu,
+                                    const float *mlo, int nb, int n);
 
 /* Moves bn's running statistics towards batch statistics (mu, var2 from a
  * training forward over n rows). Separate from the forward so a batch whose

@@ -29,13 +29,14 @@ int tcb_cc_encoder_cache_alloc(tcb_cc_encoder_cache *c, const tcb_cc_dims *d, in
     c->h1 = malloc(R * TCB_CC_ENC1 * sizeof(float));
     c->xh2 = malloc(R * TCB_CC_ENC2 * sizeof(float));
     c->h2 = malloc(R * TCB_CC_ENC2 * sizeof(float));
-    c->xh3 = malloc(R * d->C * sizeof(float));
+    c->a3 = malloc(R * d->C * sizeof(float));
+    c->mlo3 = malloc((size_t)d->C * sizeof(float));
     c->arg = malloc((size_t)B * d->C * sizeof(int32_t));
     c->g = malloc((size_t)B * d->C * sizeof(float));
     c->xhf = malloc((size_t)B * d->Z * sizeof(float));
     c->z = malloc((size_t)B * d->Z * sizeof(float));
     c->stats = malloc(nstats * sizeof(float));
-    if (!c->xh1 || !c->h1 || !c->xh2 || !c->h2 || !c->xh3 || !c->arg || !c->g || !c->xhf || !c->z || !c->stats) {
+    if (!c->xh1 || !c->h1 || !c->xh2 || !c->h2 || !c->a3 || !c->mlo3 || !c->arg || !c->g || !c->xhf || !c->z || !c->stats) {
         tcb_cc_encoder_cache_free(c);
         return tcb_fail(err, TCB_ERR_NOMEM, "cc encoder: out of memory for %d clouds of %d points", B, N);
     }
@@ -44,7 +45,7 @@ int tcb_cc_encoder_cache_alloc(tcb_cc_encoder_cache *c, const tcb_cc_dims *d, in
 
 void tcb_cc_encoder_cache_free(tcb_cc_encoder_cache *c)
 {
-    free(c->xh1), free(c->h1), free(c->xh2), free(c->h2), free(c->xh3);
+    free(c->xh1), free(c->h1), free(c->xh2), free(c->h2), free(c->a3), free(c->mlo3);
     free(c->arg), free(c->g), free(c->xhf), free(c->z), free(c->stats);
     memset(c, 0, sizeof *c);
 }
@@ -79,9 +80,16 @@ void tcb_cc_encoder_forward(const tcb_cc_encoder *e, tcb_cc_encoder_cache *c, fl
     norm(&e->bn1, c->h1, c->xh1, stats_of(c, BN1), pre, R, train, 1);
     tcb_linear_forward(pre, c->h1, e->conv2.W, e->conv2.b, R, 0, TCB_CC_ENC1, TCB_CC_ENC2);
     norm(&e->bn2, c->h2, c->xh2, stats_of(c, BN2), pre, R, train, 1);
-    tcb_linear_forward(pre, c->h2, e->conv3.W, e->conv3.b, R, 0, TCB_CC_ENC2, C);
-    norm(&e->bn3, pre, c->xh3, stats_of(c, BN3), pre, R, train, 0);
-    tcb_maxpool_forward(c->g, c->arg, pre, B, N, C);
+    if (train) { /* bn3 and the pool fused: BN(a3) is never written */
+        float *st = stats_of(c, BN3);
+        tcb_linear_forward(c->a3, c->h2, e->conv3.W, e->conv3.b, R, 0, TCB_CC_ENC2, C);
+        tcb_batchnorm_maxpool_forward_train(&e->bn3, c->g, c->arg, st, st + C, c->mlo3, st + 2 * C, c->a3, B, N);
+        tcb_batchnorm_update_running(&e->bn3, st + C, st + 2 * C, R);
+    } else {
+        tcb_linear_forward(pre, c->h2, e->conv3.W, e->conv3.b, R, 0, TCB_CC_ENC2, C);
+        tcb_batchnorm_forward_eval(&e->bn3, pre, pre, R, 0);
+        tcb_maxpool_forward(c->g, c->arg, pre, B, N, C);
+    }
     tcb_linear_forward(c->z, c->g, e->fc.W, e->fc.b, B, 0, C, Z);
     norm(&e->bnf, c->z, c->xhf, stats_of(c, BNF), c->z, B, train, 1);
 }
@@ -111,11 +119,8 @@ void tcb_cc_encoder_backward(const tcb_cc_encoder *e, const tcb_cc_encoder *grad
      * computes them as rounding noise), so they are not summed (db NULL) */
     tcb_batchnorm_backward(&e->bnf, &grad->bnf, df, dz, c->z, c->xhf, stats_of(c, BNF), B);
     tcb_linear_backward(dg, grad->fc.W, NULL, df, c->g, e->fc.W, B, 0, C, Z);
-    /* the max-pool routes each (cloud, channel) gradient to its one point */
-    memset(d3, 0, (size_t)R * C * sizeof(float));
-    for (int b = 0; b < B; b++)
-        for (int j = 0; j < C; j++) d3[((size_t)b * N + c->arg[(size_t)b * C + j]) * C + j] = dg[(size_t)b * C + j];
-    tcb_batchnorm_backward(&e->bn3, &grad->bn3, d3, d3, NULL, c->xh3, stats_of(c, BN3), R);
+    const float *st = stats_of(c, BN3);
+    tcb_batchnorm_maxpool_backward(&e->bn3, &grad->bn3, d3, dg, c->arg, c->a3, st, st + C, c->mlo3, B, N);
     tcb_linear_backward(d2, grad->conv3.W, NULL, d3, c->h2, e->conv3.W, R, 0, TCB_CC_ENC2, C);
     tcb_batchnorm_backward(&e->bn2, &grad->bn2, d2, d2, c->h2, c->xh2, stats_of(c, BN2), R);
     tcb_linear_backward(d1, grad->conv2.W, NULL, d2, c->h1, e->conv2.W, R, 0, TCB_CC_ENC1, TCB_CC_ENC2);

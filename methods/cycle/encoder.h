@@ -24,7 +24,8 @@ typedef struct tcb_cc_encoder_cache {
     const float *x; /* [B·N][3] */
     float *xh1, *h1; /* [B·N][64] bn1's x̂, and after ReLU */
     float *xh2, *h2; /* [B·N][128] */
-    float *xh3;      /* [B·N][C] */
+    float *a3;       /* [B·N][C] conv3's output: bn3 and the pool recompute x̂ from it */
+    float *mlo3;     /* [C] bn3's mean, low float part */
     int32_t *arg;    /* [B][C] the point each channel's max came from */
     float *g;        /* [B][C] max-pooled */
     float *xhf;      /* [B][Z] */

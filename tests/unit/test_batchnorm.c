@@ -23,6 +23,7 @@
 #include <string.h>
 
 #include "neural/batchnorm.h"
+#include "neural/layers.h"
 #include "tcb/rng.h"
 #include "testutil.h"
 
@@ -370,6 +371,62 @@ static void test_threads(void **state)
     free(x), free(a);
 }
 
+/* The fused batch norm and max-pool (PointNet's last layer) against the
+ * two layers it fuses, bit for bit, with 1 and 2 threads: forward_train
+ * then tcb_maxpool_forward, and the backward of dg scattered to the max
+ * rows. nb = 5 sets of n = 90 rows: the reductions' four row blocks
+ * (boundaries 112, 225, 337) cut through sets; R·C = 36,000 takes the
+ * parallel path. Every third channel's γ is negative (the max comes from
+ * the smallest x), the inputs sit 100 above their spread (the mean's low
+ * part matters) and take 12 levels a channel, so ties in the max occur
+ * and the first row must win. */
+static void test_fused_maxpool(void **state)
+{
+    (void)state;
+    enum { nb = 5, n = 90, C = 80, R = nb * n };
+    size_t len = (size_t)R * C;
+    tcb_rng rng;
+    tcb_rng_seed_stream(&rng, 1, "test/batchnorm/maxpool");
+    layer L;
+    layer_make(&L, C, &rng);
+    for (int c = 0; c < C; c += 3) L.bn.gamma[c] = -L.bn.gamma[c];
+    float *x = tu_falloc(len), *y = tu_falloc(len), *xh = tu_falloc(len), *d = tu_falloc(len);
+    float *dx = tu_falloc(len);
+    for (size_t i = 0; i < len; i++) x[i] = 100.0f + (float)floor(12.0 * tcb_rng_uniform(&rng)) / 12.0f;
+    float dg[nb * C], g[nb * C], gf[nb * C], st[3][C], sf[4][C];
+    int32_t arg[nb * C], argf[nb * C];
+    tu_fill_uniform(&rng, dg, nb * C, -1, 1);
+    /* the unfused layers */
+    tcb_batchnorm_forward_train(&L.bn, y, xh, st[0], st[1], st[2], x, R, 0);
+    tcb_maxpool_forward(g, arg, y, nb, n, C);
+    int ties = 0; /* rows other than the kept one that reach the max: the first must win */
+    for (int b = 0; b < nb; b++)
+        for (int j = 0; j < C; j++)
+            for (int i = 0; i < n; i++) ties += i != arg[b * C + j] && y[((size_t)b * n + i) * C + j] == g[b * C + j];
+    assert_true(ties > 0);
+    memset(d, 0, len * sizeof(float));
+    for (int b = 0; b < nb; b++)
+        for (int j = 0; j < C; j++) d[((size_t)b * n + arg[b * C + j]) * C + j] = dg[b * C + j];
+    tcb_batchnorm_backward(&L.bn, &L.g, d, d, NULL, xh, st[0], R);
+    float gref[2 * C];
+    memcpy(gref, L.grads, sizeof gref);
+    int prev = omp_get_max_threads();
+    for (int t = 1; t <= 2; t++) {
+        omp_set_num_threads(t);
+        memset(L.grads, 0, sizeof L.grads);
+        tcb_batchnorm_maxpool_forward_train(&L.bn, gf, argf, sf[0], sf[1], sf[2], sf[3], x, nb, n);
+        tcb_batchnorm_maxpool_backward(&L.bn, &L.g, dx, dg, argf, x, sf[0], sf[1], sf[2], nb, n);
+        assert_memory_equal(gf, g, sizeof g);
+        assert_memory_equal(argf, arg, sizeof arg);
+        assert_memory_equal(sf[0], st[0], 2 * C * sizeof(float)); /* rstd, mean */
+        assert_memory_equal(sf[3], st[2], C * sizeof(float));     /* variance */
+        assert_memory_equal(dx, d, len * sizeof(float));
+        assert_memory_equal(L.grads, gref, sizeof gref);
+    }
+    omp_set_num_threads(prev);
+    free(x), free(y), free(xh), free(d), free(dx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -377,6 +434,7 @@ int main(void)
         cmocka_unit_test(test_offset_input),
         cmocka_unit_test(test_fused_relu),
         cmocka_unit_test(test_threads),
+        cmocka_unit_test(test_fused_maxpool),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
