@@ -26,7 +26,9 @@
  * m×n×k: atlas the decoder's second layer, (1+nt)·B·m rows × H1 → H2, or
  * the encoder's last convolution, B·N rows × 128 → C, whichever has more
  * multiply-adds; cc that convolution; neupig the MLP's hidden layer, T·nv
- * rows × H → H), each a warm-up call and then calls for 0.3 s. RSS: each process's peak
+ * rows × H → H), each a warm-up call and then calls for 0.3 s; and, after
+ * the rows, its memory's rate on a triad (memory_triad), which bounds the
+ * thread scaling of the passes that are not products. RSS: each process's peak
  * resident set (getrusage ru_maxrss); the C process's is its peak so far,
  * as the rows run from the smaller preset up.
  *
@@ -179,6 +181,32 @@ static double sgemm_gflops(gemm_shape g)
     }
     free(a), free(b), free(c);
     return 2.0 * macs_of(g) * reps / (t * 1e6);
+}
+
+/* GB/s of the triad c = 1.5·a + b over arrays of 40 M floats (PointNet's
+ * last activation at the paper's scale, 160 MB each: far past the caches)
+ * at the current thread count, the best of 5: the rate of the step's
+ * memory-bound passes (batch norms, ReLUs, bias fills), whose 1 → 2 thread
+ * ratio bounds theirs as sgemm's bounds the products'. */
+static double memory_triad(void)
+{
+    size_t n = (size_t)40 << 20;
+    float *a = malloc(n * sizeof(float)), *b = malloc(n * sizeof(float)), *c = malloc(n * sizeof(float));
+    if (!a || !b || !c) die("triad: out of memory");
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) a[i] = (float)(i % 7), b[i] = 1.0f, c[i] = 0.0f;
+    double best = 1e30;
+    for (int r = 0; r < 5; r++) {
+        double t0 = bench_now_ms();
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n; i++) c[i] = 1.5f * a[i] + b[i];
+        double t = bench_now_ms() - t0;
+        if (t < best) best = t;
+    }
+    volatile float sink = c[n / 2];
+    (void)sink;
+    free(a), free(b), free(c);
+    return 3.0 * n * sizeof(float) / (best * 1e6);
 }
 
 /* The atlas step's dominant product (the header's comment). */
@@ -523,5 +551,9 @@ int main(int argc, char **argv)
         if (want && (!o.method || strcmp(o.method, "pdg") == 0)) run_pdg_row(&o, &presets[i], &seq);
     }
     tcb_sequence_free(&seq);
+    /* last: its 0.5 GB would otherwise be every C row's peak RSS */
+    printf("This machine's memory (c = 1.5a + b over 3 x 168 MB, %d thread(s), measured now): %.1f GB/s;\n"
+           "  its ratio between thread counts bounds that of the steps' memory-bound passes.\n",
+           o.threads, memory_triad());
     return 0;
 }
