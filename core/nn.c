@@ -193,6 +193,16 @@ static void brute_nearest(const tcb_nn *nn, const float *q, int32_t *idx, float 
     *d2 = best[m];
 }
 
+/* The nearest point of queries [q0, q1). */
+static void brute_query1_range(const tcb_nn *nn, const float *queries, int q0, int q1, int32_t *idx, float *d2)
+{
+    for (int q = q0; q < q1; q++) {
+        float d;
+        brute_nearest(nn, queries + 3 * (size_t)q, idx + q, &d);
+        if (d2) d2[q] = d;
+    }
+}
+
 /* out[j] = squared distance from q to point j, for all j < npad. */
 static void brute_row(const tcb_nn *nn, const float *q, float *restrict out)
 {
@@ -225,22 +235,42 @@ static void brute_select(const float *row, int n, int k, int32_t *idx, float *d2
         if (len < k || row[j] < d2[k - 1]) row_insert(d2, idx, &len, k, row[j], j);
 }
 
+/* Queries [q0, q1) into idx (and d2, else scratch [k]), row [npad] the
+ * distances' buffer. */
+static void brute_queryk_range(const tcb_nn *nn, const float *queries, int q0, int q1, int k, int32_t *idx,
+                               float *d2, float *row, float *scratch)
+{
+    for (int q = q0; q < q1; q++) {
+        brute_row(nn, queries + 3 * (size_t)q, row);
+        brute_select(row, nn->n, k, idx + (size_t)q * k, d2 ? d2 + (size_t)q * k : scratch);
+    }
+}
+
 static int brute_queryk(const tcb_nn *nn, const float *queries, int nq, int k, int32_t *idx,
                         float *d2, tcb_error *err)
 {
     int failed = 0;
     double work = (double)nq * nn->n;
-#pragma omp parallel if (work > PAR_MIN_WORK) reduction(| : failed)
+    if (work <= PAR_MIN_WORK) {
+        /* Outside any OpenMP construct and without the heap: a small query
+         * (tcb_mesh_locate asks one point at a time) cost 2 to 3 times its
+         * search in the construct's entry and the buffers' allocation. */
+        float row_buf[TCB_NN_BRUTE_MAX + LANES], scratch_buf[64];
+        float *row = nn->npad <= TCB_NN_BRUTE_MAX + LANES ? row_buf : malloc((size_t)nn->npad * sizeof(float));
+        float *scratch = d2 || k <= 64 ? scratch_buf : malloc((size_t)k * sizeof(float));
+        failed = !row || !scratch;
+        if (!failed) brute_queryk_range(nn, queries, 0, nq, k, idx, d2, row, scratch);
+        if (row != row_buf) free(row);
+        if (scratch != scratch_buf) free(scratch);
+        return failed ? tcb_fail(err, TCB_ERR_NOMEM, "nn: out of memory") : TCB_OK;
+    }
+#pragma omp parallel reduction(| : failed)
     {
         float *row = malloc((size_t)nn->npad * sizeof(float));
         float *scratch = d2 ? NULL : malloc((size_t)k * sizeof(float));
         failed = !row || (!d2 && !scratch);
-#pragma omp for schedule(static)
-        for (int q = 0; q < nq; q++) {
-            if (failed) continue;
-            brute_row(nn, queries + 3 * (size_t)q, row);
-            brute_select(row, nn->n, k, idx + (size_t)q * k, d2 ? d2 + (size_t)q * k : scratch);
-        }
+        int t = omp_get_thread_num(), nt = omp_get_num_threads();
+        if (!failed) brute_queryk_range(nn, queries, (int)((long long)nq * t / nt), (int)((long long)nq * (t + 1) / nt), k, idx, d2, row, scratch);
         free(row), free(scratch);
     }
     return failed ? tcb_fail(err, TCB_ERR_NOMEM, "nn: out of memory") : TCB_OK;
@@ -294,12 +324,15 @@ int tcb_nn_query1(const tcb_nn *nn, const float *queries, int nq, int32_t *idx, 
     int rc = check_coords(queries, nq, "query", err);
     if (rc || nq == 0) return rc;
     if (nn->backend == TCB_NN_KDTREE) return kdtree_queryk(nn, queries, nq, 1, idx, d2, err);
-    double work = (double)nq * nn->n;
-#pragma omp parallel for schedule(static) if (work > PAR_MIN_WORK)
-    for (int q = 0; q < nq; q++) {
-        float d;
-        brute_nearest(nn, queries + 3 * (size_t)q, idx + q, &d);
-        if (d2) d2[q] = d;
+    /* a small query outside any OpenMP construct: brute_queryk's reason */
+    if ((double)nq * nn->n <= PAR_MIN_WORK) {
+        brute_query1_range(nn, queries, 0, nq, idx, d2);
+        return TCB_OK;
+    }
+#pragma omp parallel
+    {
+        int t = omp_get_thread_num(), nt = omp_get_num_threads();
+        brute_query1_range(nn, queries, (int)((long long)nq * t / nt), (int)((long long)nq * (t + 1) / nt), idx, d2);
     }
     return TCB_OK;
 }

@@ -6,20 +6,31 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# Each stage's wall time is printed at the end with the slowest tests, so
+# the next stage or test that makes the suite slow is visible.
+stage_t0=$SECONDS
+stages=()
+stage() { stages+=("$(printf '  %8d s  %s' $((SECONDS - stage_t0)) "$1")"); stage_t0=$SECONDS; }
+print_stages() { echo "time by stage:"; printf '%s\n' "${stages[@]}"; }
+
 scripts/setup.sh --tests
+stage "packages (scripts/setup.sh --tests)"
 cmake -S . -B build-test -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTCB_SANITIZE=ON >/dev/null
 cmake --build build-test -j"$(nproc)" >/dev/null
+stage "sanitized build (build-test)"
 # The default benchmark's regression check runs the Release binary README
 # command 1 builds (the same build directory): its 24 cells under the
 # sanitizers would take most of the suite's time, and every method runs
 # sanitized in its own tests.
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DTCB_BUILD_TESTS=OFF >/dev/null
 cmake --build build -j"$(nproc)" >/dev/null
+stage "Release build (build)"
 # The fuzz targets (fuzz/README.md), built by clang with libFuzzer: each
 # searches for TCB_FUZZ_SMOKE_S (10) seconds from its seeds, after the
 # suite. (The sanitized build above replays their seeds and regressions.)
 CC=clang cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTCB_FUZZ=ON -DTCB_BUILD_TESTS=OFF >/dev/null
 cmake --build build-fuzz -j"$(nproc)" --target fuzz_targets >/dev/null
+stage "fuzz targets (build-fuzz, clang)"
 export TCBENCH_RELEASE="$PWD/build/tcbench"
 export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1
 # Each suite's log is kept so that its ten slowest tests are printed at the
@@ -33,8 +44,11 @@ slowest() {
 }
 status=0
 (cd build-test && ctest --output-on-failure -j"$(nproc)" "$@") 2>&1 | tee "$log/tests" || status=1
+stage "tests (build-test)"
 slowest tests
-[ "$status" = 0 ] || exit 1
+[ "$status" = 0 ] || { print_stages; exit 1; }
 (cd build-fuzz && ctest --output-on-failure -j"$(nproc)" "$@") 2>&1 | tee "$log/fuzz" || status=1
+stage "fuzz searches (build-fuzz)"
 slowest fuzz
+print_stages
 exit "$status"
