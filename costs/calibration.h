@@ -104,7 +104,8 @@ int tcb_cost_lookup(const tcb_calibration_set *s, const tcb_cost_key *key, int t
 /* Prices a cell's estimate: one that named a preset with steps
  * (abi_version >= 5) gets fit_s = steps x the step cost (x the frames over
  * the calibration sequence's with step_frames) and eval_s from the pair
- * costs; its unit uses (abi_version >= 6) are added at their counts,
+ * costs, scaled with the vertex count's ratio (a pair carries every
+ * vertex); its unit uses (abi_version >= 6) are added at their counts,
  * scaled with the vertex count's ratio to the calibration sequence's to
  * their exponent; a method with a surface (surface_samples > 0: the
  * config's samples per mesh) gets the reconstruction metrics of the frames

@@ -136,7 +136,8 @@ static int price_preset(const tcb_calibration_set *s, const char *method, const 
     char threads[64];
     threads_text(&step, q->n_threads, threads, sizeof threads);
     e->fit_s = (double)e->steps * step.seconds * frames;
-    e->eval_s = q->n_pairs * pair.seconds;
+    /* a pair carries every vertex of its source frame: linear in the count */
+    e->eval_s = q->n_pairs * pair.seconds * (q->n_verts > 0 ? (double)q->n_verts / pair.from->n_verts : 1);
     snprintf(e->basis, sizeof e->basis, "%lld steps x %.1f ms%s (%.60s, %.80s)", e->steps,
              step.seconds * frames * 1e3, e->step_frames ? " at its frames" : "", threads, step.from->machine);
     return 1;
