@@ -160,6 +160,19 @@ void tcb_batchnorm_forward_eval(const tcb_batchnorm *bn, float *y, const float *
     }
 }
 
+/* From the column sums sd = Σdy and sdx = Σdy·x̂ over n rows: dβ and dγ
+ * accumulated, and dx's coefficients a = γ·rstd, mb = sd/n, mg = sdx/n. */
+static void backward_coefficients(const tcb_batchnorm *bn, const tcb_batchnorm *grad, const float *rstd,
+                                  const double *sd, const double *sdx, int n, float *a, float *mb, float *mg)
+{
+    for (int j = 0; j < bn->C; j++) {
+        grad->beta[j] += (float)sd[j];
+        grad->gamma[j] += (float)sdx[j];
+        a[j] = bn->gamma[j] * rstd[j];
+        mb[j] = (float)(sd[j] / n), mg[j] = (float)(sdx[j] / n);
+    }
+}
+
 void tcb_batchnorm_backward(const tcb_batchnorm *bn, const tcb_batchnorm *grad, float *dx, const float *dy,
                             const float *y, const float *xhat, const float *rstd, int n)
 {
@@ -172,12 +185,7 @@ void tcb_batchnorm_backward(const tcb_batchnorm *bn, const tcb_batchnorm *grad, 
     double sd[TCB_BN_MAX_C], sdx[TCB_BN_MAX_C];
     moments(dy, xhat, zero, zero, n, C, sd, sdx);
     float a[TCB_BN_MAX_C], mb[TCB_BN_MAX_C], mg[TCB_BN_MAX_C];
-    for (int j = 0; j < C; j++) {
-        grad->beta[j] += (float)sd[j];
-        grad->gamma[j] += (float)sdx[j];
-        a[j] = bn->gamma[j] * rstd[j];
-        mb[j] = (float)(sd[j] / n), mg[j] = (float)(sdx[j] / n);
-    }
+    backward_coefficients(bn, grad, rstd, sd, sdx, n, a, mb, mg);
 #pragma omp parallel for schedule(static) if ((double)n * C > PAR_MIN)
     for (int r = 0; r < n; r++) {
         size_t at = (size_t)r * C;
@@ -219,12 +227,7 @@ void tcb_batchnorm_maxpool_backward(const tcb_batchnorm *bn, const tcb_batchnorm
     double sd[TCB_BN_MAX_C], sdx[TCB_BN_MAX_C];
     sparse_moments(dg, arg, x, rstd, mu, mlo, nb, n, C, sd, sdx);
     float a[TCB_BN_MAX_C], mb[TCB_BN_MAX_C], mg[TCB_BN_MAX_C];
-    for (int j = 0; j < C; j++) {
-        grad->beta[j] += (float)sd[j];
-        grad->gamma[j] += (float)sdx[j];
-        a[j] = bn->gamma[j] * rstd[j];
-        mb[j] = (float)(sd[j] / R), mg[j] = (float)(sdx[j] / R);
-    }
+    backward_coefficients(bn, grad, rstd, sd, sdx, R, a, mb, mg);
     /* tcb_batchnorm_backward's dx with dy = 0 everywhere, then the max rows
      * with their dy */
 #pragma omp parallel for schedule(static) if ((double)R * C > PAR_MIN)
