@@ -26,6 +26,8 @@ typedef struct tcb_meshing_ops {
     int (*normals)(const float *pts, int n, int k, float *normals, tcb_error *err);
     /* CGAL's isotropic remeshing toward edge_length, `iterations` rounds. */
     int (*remesh)(const tcb_mesh *in, double edge_length, int iterations, tcb_mesh *out, tcb_error *err);
+    /* Qhull's convex hull (through Open3D), triangles in any winding. */
+    int (*convex_hull)(const float *pts, int n, tcb_mesh *out, tcb_error *err);
 } tcb_meshing_ops;
 
 typedef const tcb_meshing_ops *(*tcb_meshing_entry_fn)(void);

@@ -200,3 +200,81 @@ int tcb_estimate_normals(const float *pts, int n, int k, float *normals, tcb_err
     orient_outward(pts, n, normals);
     return TCB_OK;
 }
+
+/* Each face wound so that its normal points away from c, a point inside
+ * the convex hull (the mean of its vertices): the right winding for every
+ * face of a convex surface. */
+static void wind_outward(tcb_mesh *m)
+{
+    double c[3] = {0, 0, 0};
+    for (int i = 0; i < m->n_verts; i++)
+        for (int d = 0; d < 3; d++) c[d] += m->verts[3 * i + d] / (double)m->n_verts;
+    for (int f = 0; f < m->n_faces; f++) {
+        int32_t *t = m->faces + 3 * f;
+        const float *a = m->verts + 3 * t[0], *b = m->verts + 3 * t[1], *e = m->verts + 3 * t[2];
+        double u[3], v[3], w[3];
+        for (int d = 0; d < 3; d++) u[d] = b[d] - a[d], v[d] = e[d] - a[d], w[d] = a[d] - c[d];
+        double nx = u[1] * v[2] - u[2] * v[1], ny = u[2] * v[0] - u[0] * v[2], nz = u[0] * v[1] - u[1] * v[0];
+        if (nx * w[0] + ny * w[1] + nz * w[2] < 0) {
+            int32_t x = t[1];
+            t[1] = t[2], t[2] = x;
+        }
+    }
+}
+
+int tcb_convex_hull(const float *pts, int n, tcb_mesh *out, tcb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    int rc = check_points(pts, n, 4, err);
+    if (rc) return rc;
+    backend b;
+    if ((rc = backend_open(&b, err))) return rc;
+    rc = b.ops->convex_hull(pts, n, out, err);
+    backend_close(&b);
+    if (!rc) rc = check_result(out, "the convex hull", err);
+    if (rc) {
+        tcb_mesh_free(out);
+        return rc;
+    }
+    wind_outward(out);
+    return TCB_OK;
+}
+
+/* Unit directions spread evenly over the sphere: the Fibonacci lattice
+ * (golden-angle spiral), k of them. */
+static void sphere_directions(int k, double *dirs)
+{
+    const double golden = M_PI * (3.0 - sqrt(5.0));
+    for (int i = 0; i < k; i++) {
+        double z = 1.0 - (2.0 * i + 1.0) / k, r = sqrt(1.0 - z * z);
+        dirs[3 * i] = r * cos(golden * i), dirs[3 * i + 1] = r * sin(golden * i), dirs[3 * i + 2] = z;
+    }
+}
+
+int tcb_convex_offset(const float *pts, int n, double offset, tcb_mesh *out, tcb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (!(offset > 0) || !isfinite(offset))
+        return tcb_fail(err, TCB_ERR_INPUT, "meshing: an offset of %g (need a positive distance)", offset);
+    tcb_mesh hull;
+    int rc = tcb_convex_hull(pts, n, &hull, err);
+    if (rc) return rc;
+    size_t m = (size_t)hull.n_verts * TCB_OFFSET_DIRECTIONS;
+    double dirs[3 * TCB_OFFSET_DIRECTIONS];
+    float *sum = malloc(m * 3 * sizeof *sum);
+    if (!sum) {
+        tcb_mesh_free(&hull);
+        return tcb_fail(err, TCB_ERR_NOMEM, "meshing: out of memory for an offset of %d points", hull.n_verts);
+    }
+    sphere_directions(TCB_OFFSET_DIRECTIONS, dirs);
+    for (int i = 0; i < hull.n_verts; i++)
+        for (int k = 0; k < TCB_OFFSET_DIRECTIONS; k++)
+            for (int d = 0; d < 3; d++)
+                sum[3 * ((size_t)i * TCB_OFFSET_DIRECTIONS + k) + d] =
+                    (float)(hull.verts[3 * i + d] + offset * dirs[3 * k + d]);
+    tcb_mesh_free(&hull);
+    rc = tcb_convex_hull(sum, (int)m, out, err);
+    free(sum);
+    return rc;
+}
+

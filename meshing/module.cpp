@@ -29,7 +29,7 @@ int alloc_mesh(size_t nv, size_t nf, tcb_mesh *out, tcb_error *err)
 }
 
 namespace {
-const tcb_meshing_ops ops = {poisson, decimate, normals, remesh};
+const tcb_meshing_ops ops = {poisson, decimate, normals, remesh, convex_hull};
 }
 
 } // namespace tcb_meshing

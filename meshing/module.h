@@ -19,6 +19,7 @@ namespace tcb_meshing {
 int poisson(const float *pts, const float *normals, int n, int depth, tcb_mesh *out, tcb_error *err);
 int decimate(const tcb_mesh *in, int max_faces, tcb_mesh *out, tcb_error *err);
 int normals(const float *pts, int n, int k, float *out, tcb_error *err);
+int convex_hull(const float *pts, int n, tcb_mesh *out, tcb_error *err);
 // cgal.cpp
 int remesh(const tcb_mesh *in, double edge_length, int iterations, tcb_mesh *out, tcb_error *err);
 

@@ -1,5 +1,6 @@
 // The Open3D half of the meshing module: tcbench's C calls turned into
-// Open3D 0.16 calls (screened Poisson, quadric decimation, PCA normals).
+// Open3D 0.16 calls (screened Poisson, quadric decimation, PCA normals,
+// the convex hull).
 // Inputs arrive checked by meshing/meshing.c.
 #include <open3d/geometry/KDTreeSearchParam.h>
 #include <open3d/geometry/PointCloud.h>
@@ -107,6 +108,18 @@ int normals(const float *pts, int n, int k, float *out, tcb_error *err)
             for (int d = 0; d < 3; d++) out[3 * i + d] = (float)u[d];
         }
         return (int)TCB_OK;
+    });
+}
+
+// The convex hull as DynoSurf's grid takes it (open3d's
+// compute_convex_hull: Qhull's triangulated hull, no joggling). The
+// triangles' winding is meshing.c's to fix.
+int convex_hull(const float *pts, int n, tcb_mesh *out, tcb_error *err)
+{
+    return open3d_call("convex hull", err, [&] {
+        PointCloud pc = make_cloud(pts, nullptr, n);
+        auto hull = std::get<0>(pc.ComputeConvexHull(false));
+        return to_tcb_mesh(*hull, out, err);
     });
 }
 

@@ -65,6 +65,7 @@ OWNER = {
     "mesh": "core", "sysinfo": "core", "version": "core",
     "metrics": "metrics", "geodesic": "metrics", "bootstrap": "metrics", "wilcoxon": "metrics",
     "locate": "meshing", "meshing": "meshing", "cholesky": "meshing", "large_steps": "meshing",
+    "tetmesh": "meshing",
     "sequence": "datasets", "split": "datasets", "synth": "datasets", "align": "datasets",
     "block": "datasets", "dfaust": "datasets", "distortion": "datasets", "mesh_io": "datasets",
     "method": "interface", "registry": "interface",

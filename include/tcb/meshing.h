@@ -73,6 +73,25 @@ int tcb_mesh_remesh(const tcb_mesh *in, double edge_length, int iterations, tcb_
  * (true for any closed shape, convex or not). */
 int tcb_estimate_normals(const float *pts, int n, int k, float *normals, tcb_error *err);
 
+/* The convex hull of n ≥ 4 points that do not all lie in a plane (Qhull,
+ * through Open3D's compute_convex_hull, as DynoSurf's grid takes it):
+ * closed, triangulated, every face wound outward. Points on the hull's
+ * faces but not at its corners are not vertices of it. */
+int tcb_convex_hull(const float *pts, int n, tcb_mesh *out, tcb_error *err);
+
+/* The boundary of the points' convex hull grown by `offset` (> 0): the
+ * Minkowski sum of the hull with a ball, the ball taken as the polytope of
+ * TCB_OFFSET_DIRECTIONS directions (a Fibonacci lattice, ~0.25 rad
+ * apart), so the surface lies within 2 % of offset inside the exact
+ * rounded one (its vertices between 0.985 and 1 offset from the hull in
+ * tests/unit/test_tetmesh.c). It is the convex hull of every hull vertex
+ * moved by offset along every direction, which for a convex set is exact
+ * up to that ball. DynoSurf's grid shell is this
+ * surface remeshed (MeshLab resamples the hull's distance field instead;
+ * docs/meshing.md). */
+#define TCB_OFFSET_DIRECTIONS 200
+int tcb_convex_offset(const float *pts, int n, double offset, tcb_mesh *out, tcb_error *err);
+
 #ifdef __cplusplus
 }
 #endif
