@@ -29,9 +29,11 @@ void tcb_tetmesh_free(tcb_tetmesh *t);
 #define TCB_TETGEN_PROGRAM "tetgen"
 
 /* The inside of `shell` (closed, not self-intersecting, any consistent
- * winding) filled with tetrahedra of volume at most max_volume (> 0) and
- * radius-edge ratio at most radius_edge (≥ 1.1, TetGen's smallest useful
- * bound; DynoSurf's 2.0): `tetgen -pq<radius_edge>a<max_volume>`, Steiner
+ * winding) filled with tetrahedra of volume at most max_volume (> 0: TetGen's
+ * refinement target, which a few tets by the shell exceed, 0.02 % of
+ * DynoSurf's crane grid by up to 1.5 times) and radius-edge ratio at most
+ * radius_edge (≥ 1.1, TetGen's smallest useful bound; DynoSurf's 2.0):
+ * `tetgen -pq<radius_edge>a<max_volume>`, Steiner
  * points as TetGen needs them. The shell's vertices are the first
  * shell->n_verts vertices of the result, in order. The work happens in a
  * fresh directory under $TMPDIR (else /tmp), removed afterwards.
