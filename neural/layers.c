@@ -28,6 +28,14 @@ void tcb_linear_bind(tcb_linear *l, float *base, size_t *offset, int in, int out
     *offset += (size_t)in * out + out;
 }
 
+void tcb_linear_bind_nobias(tcb_linear *l, float *base, size_t *offset, int in, int out)
+{
+    l->W = base + *offset;
+    l->b = NULL;
+    l->in = in, l->out = out;
+    *offset += (size_t)in * out;
+}
+
 void tcb_colsum_acc(float *db, const float *dy, int n, int d)
 {
     int nchunks = (d + CHUNK - 1) / CHUNK;
@@ -186,7 +194,7 @@ void tcb_linear_init_uniform(const tcb_linear *l, tcb_rng *rng)
     double bound = 1.0 / sqrt((double)l->in);
     size_t nw = (size_t)l->in * (size_t)l->out;
     for (size_t i = 0; i < nw; i++) l->W[i] = (float)((2.0 * tcb_rng_uniform(rng) - 1.0) * bound);
-    for (int i = 0; i < l->out; i++) l->b[i] = (float)((2.0 * tcb_rng_uniform(rng) - 1.0) * bound);
+    for (int i = 0; l->b && i < l->out; i++) l->b[i] = (float)((2.0 * tcb_rng_uniform(rng) - 1.0) * bound);
 }
 
 void tcb_leaky_relu_forward(float *y, const float *x, int64_t n, float slope)

@@ -33,8 +33,11 @@ typedef struct tcb_linear {
 /* Views l at base + *offset and advances *offset by its in·out + out floats. */
 void tcb_linear_bind(tcb_linear *l, float *base, size_t *offset, int in, int out);
 
-/* PyTorch's default initialisation of a Linear layer: W then b, each entry
- * U(−1/√in, 1/√in), drawn in that order from rng. */
+/* The same without a bias (Linear(..., bias=False)): b = NULL, in·out floats. */
+void tcb_linear_bind_nobias(tcb_linear *l, float *base, size_t *offset, int in, int out);
+
+/* PyTorch's default initialisation of a Linear layer: W then b (when it
+ * has one), each entry U(−1/√in, 1/√in), drawn in that order from rng. */
 struct tcb_rng;
 void tcb_linear_init_uniform(const tcb_linear *l, struct tcb_rng *rng);
 
