@@ -166,3 +166,26 @@ int tcb_sample_surface_faces(const float *verts, const int32_t *faces, int nf, i
     free(cdf);
     return TCB_OK;
 }
+
+int tcb_farthest_points(const float *pts, int n, int k, int start, int32_t *idx, tcb_error *err)
+{
+    float *best = malloc((size_t)n * sizeof *best); /* squared distance to the chosen set */
+    if (!best) return tcb_fail(err, TCB_ERR_NOMEM, "farthest points: out of memory for %d points", n);
+    for (int i = 0; i < n; i++) best[i] = INFINITY;
+    int cur = start;
+    for (int c = 0; c < k; c++) {
+        idx[c] = cur;
+        const float *p = pts + 3 * (size_t)cur;
+        int next = 0;
+        for (int i = 0; i < n; i++) {
+            const float *q = pts + 3 * (size_t)i;
+            float dx = q[0] - p[0], dy = q[1] - p[1], dz = q[2] - p[2];
+            float d = dx * dx + dy * dy + dz * dz;
+            if (d < best[i]) best[i] = d;
+            if (best[i] > best[next]) next = i;
+        }
+        cur = next;
+    }
+    free(best);
+    return TCB_OK;
+}

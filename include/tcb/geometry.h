@@ -24,6 +24,12 @@ double tcb_triangle_area(const float *a, const float *b, const float *c);
 void tcb_bbox(const float *points, size_t n, double box[6]);
 double tcb_bbox_diag(const double box[6]);
 
+/* Farthest-point sampling: idx[0] = start, then each next the point
+ * farthest (in squared distance, float as the reference's tensors) from
+ * those chosen, the first of equal maxima; k ≤ n. Fails only without
+ * memory. DynoSurf's control points (its farthest_point_sample). */
+int tcb_farthest_points(const float *pts, int n, int k, int start, int32_t *idx, tcb_error *err);
+
 /* Sum of triangle areas; faces are [nf][3] vertex ids. */
 double tcb_mesh_area(const float *verts, const int32_t *faces, int nf);
 

@@ -187,6 +187,46 @@ static void test_bbox(void **state)
     assert_float_equal(tcb_bbox_diag(box), 13.0, 1e-12);
 }
 
+/* Farthest points on a line of ten: 0 first, then the far end, then the
+ * first of the two middle points; on a random cloud every chosen point is
+ * as far from the earlier ones as any unchosen point is (the greedy rule),
+ * and no point is chosen twice. */
+static void test_farthest_points(void **state)
+{
+    (void)state;
+    float line[30] = {0};
+    for (int i = 0; i < 10; i++) line[3 * i] = (float)i;
+    int32_t idx[4];
+    tcb_error err = {0};
+    assert_int_equal(tcb_farthest_points(line, 10, 4, 0, idx, &err), TCB_OK);
+    assert_int_equal(idx[0], 0);
+    assert_int_equal(idx[1], 9);
+    assert_int_equal(idx[2], 4);
+    assert_int_equal(idx[3], 2); /* 2 and 7 both 2 from {0, 4, 9}: the first */
+    enum { N = 300, K = 30 };
+    float p[3 * N];
+    tcb_rng rng;
+    tcb_rng_seed(&rng, 5);
+    for (int i = 0; i < 3 * N; i++) p[i] = (float)tcb_rng_uniform(&rng);
+    int32_t pick[K];
+    assert_int_equal(tcb_farthest_points(p, N, K, 17, pick, &err), TCB_OK);
+    assert_int_equal(pick[0], 17);
+    for (int c = 1; c < K; c++) {
+        double far = -1, chosen = 0;
+        for (int i = 0; i < N; i++) {
+            double near = INFINITY;
+            for (int e = 0; e < c; e++) {
+                double d = 0;
+                for (int x = 0; x < 3; x++) d += ((double)p[3 * i + x] - p[3 * pick[e] + x]) * ((double)p[3 * i + x] - p[3 * pick[e] + x]);
+                near = d < near ? d : near;
+            }
+            far = near > far ? near : far;
+            if (i == pick[c]) chosen = near;
+        }
+        assert_true(chosen > 0 && fabs(chosen - far) <= 1e-6 * far);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -199,6 +239,7 @@ int main(void)
         cmocka_unit_test(test_sampling_deterministic_and_on_surface),
         cmocka_unit_test(test_sampling_face_frequencies),
         cmocka_unit_test(test_sampling_zero_area_fails),
+        cmocka_unit_test(test_farthest_points),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
