@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "meshing/backend.h"
+#include "meshing/meshing_internal.h"
 #include "tcb/geometry.h"
 
 /* The module lives in the directory of the libtcbench that holds this code
@@ -86,7 +87,7 @@ static int check_normals(const float *normals, int n, tcb_error *err)
     return TCB_OK;
 }
 
-static int check_mesh(const tcb_mesh *m, tcb_error *err)
+int tcb_meshing_check_mesh(const tcb_mesh *m, tcb_error *err)
 {
     if (!m || !m->verts || !m->faces || m->n_verts < 3 || m->n_faces < 1)
         return tcb_fail(err, TCB_ERR_INPUT, "meshing: the mesh is empty (%d vertices, %d faces)", m ? m->n_verts : 0,
@@ -131,7 +132,7 @@ int tcb_poisson_reconstruct(const float *pts, const float *normals, int n, int d
 int tcb_mesh_remesh(const tcb_mesh *in, double edge_length, int iterations, tcb_mesh *out, tcb_error *err)
 {
     memset(out, 0, sizeof *out);
-    int rc = check_mesh(in, err);
+    int rc = tcb_meshing_check_mesh(in, err);
     if (rc) return rc;
     if (!(edge_length > 0) || !isfinite(edge_length))
         return tcb_fail(err, TCB_ERR_INPUT, "meshing: a target edge length of %g (need a positive length)",
@@ -159,7 +160,7 @@ int tcb_mesh_remesh(const tcb_mesh *in, double edge_length, int iterations, tcb_
 int tcb_mesh_decimate(const tcb_mesh *in, int max_faces, tcb_mesh *out, tcb_error *err)
 {
     memset(out, 0, sizeof *out);
-    int rc = check_mesh(in, err);
+    int rc = tcb_meshing_check_mesh(in, err);
     if (rc) return rc;
     if (max_faces < 4)
         return tcb_fail(err, TCB_ERR_INPUT, "meshing: a budget of %d triangles (need at least 4)", max_faces);

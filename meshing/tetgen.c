@@ -14,8 +14,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "meshing/meshing_internal.h"
 #include "tcb/fsutil.h"
-#include "tcb/geometry.h"
 
 extern char **environ;
 
@@ -28,16 +28,11 @@ void tcb_tetmesh_free(tcb_tetmesh *t)
 
 static int check_shell(const tcb_mesh *m, tcb_error *err)
 {
-    if (!m || !m->verts || !m->faces || m->n_verts < 4 || m->n_faces < 4)
-        return tcb_fail(err, TCB_ERR_INPUT, "tetgen: the shell is empty (%d vertices, %d faces)",
-                        m ? m->n_verts : 0, m ? m->n_faces : 0);
-    if (!tcb_all_finite(m->verts, (size_t)3 * m->n_verts))
-        return tcb_fail(err, TCB_ERR_NUMERIC, "tetgen: a shell vertex is not finite");
-    for (int i = 0; i < 3 * m->n_faces; i++)
-        if (m->faces[i] < 0 || m->faces[i] >= m->n_verts)
-            return tcb_fail(err, TCB_ERR_INPUT, "tetgen: shell face %d names vertex %d of %d", i / 3,
-                            m->faces[i], m->n_verts);
-    return TCB_OK;
+    int rc = tcb_meshing_check_mesh(m, err);
+    if (!rc && (m->n_verts < 4 || m->n_faces < 4))
+        rc = tcb_fail(err, TCB_ERR_INPUT, "tetgen: a shell of %d vertices and %d faces encloses nothing", m->n_verts,
+                      m->n_faces);
+    return rc;
 }
 
 /* The shell as TetGen's .smesh: nodes, then the facets, no holes or

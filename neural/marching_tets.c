@@ -47,16 +47,18 @@ static void edge_vertex(const float *x, const float *s, int32_t a, int32_t b, fl
     for (int d = 0; d < 3; d++) v[d] = x[3 * (size_t)a + d] * wa + x[3 * (size_t)b + d] * wb;
 }
 
-/* The sorted unique crossing edges of the crossing tets into *keys. */
-static int crossing_edges(const float *s, const int32_t *tets, int nt, uint64_t **keys, int *n, tcb_error *err)
+/* The sorted unique crossing edges of the crossing tets into *keys;
+ * code[t] is tet t's occupancy code. */
+static int crossing_edges(const float *s, const int32_t *tets, const uint8_t *code, int nt, uint64_t **keys, int *n,
+                          tcb_error *err)
 {
     size_t cap = 0, m = 0;
-    for (int t = 0; t < nt; t++) cap += N_TRIANGLES[tet_code(s, tets + 4 * (size_t)t)] ? 6 : 0;
+    for (int t = 0; t < nt; t++) cap += N_TRIANGLES[code[t]] ? 6 : 0;
     *keys = malloc((cap ? cap : 1) * sizeof **keys);
     if (!*keys) return tcb_fail(err, TCB_ERR_NOMEM, "marching tets: out of memory for %zu edges", cap);
     for (int t = 0; t < nt; t++) {
         const int32_t *q = tets + 4 * (size_t)t;
-        if (!N_TRIANGLES[tet_code(s, q)]) continue;
+        if (!N_TRIANGLES[code[t]]) continue;
         for (int e = 0; e < 6; e++) {
             int32_t a = q[TET_EDGES[e][0]], b = q[TET_EDGES[e][1]];
             if ((s[a] > 0.0f) != (s[b] > 0.0f)) (*keys)[m++] = edge_key(a, b);
@@ -77,15 +79,14 @@ static int32_t vertex_of(const uint64_t *keys, int n, uint64_t key)
 }
 
 /* The faces of the tets with `count` triangles, in tet order, from faces[at]. */
-static int add_faces(const float *s, const int32_t *tets, int nt, const uint64_t *keys, int nk, int count,
+static int add_faces(const int32_t *tets, const uint8_t *code, int nt, const uint64_t *keys, int nk, int count,
                      int32_t *faces, int at)
 {
     for (int t = 0; t < nt; t++) {
         const int32_t *q = tets + 4 * (size_t)t;
-        int code = tet_code(s, q);
-        if (N_TRIANGLES[code] != count) continue;
+        if (N_TRIANGLES[code[t]] != count) continue;
         for (int c = 0; c < 3 * count; c++) {
-            const int *e = TET_EDGES[TRIANGLES[code][c]];
+            const int *e = TET_EDGES[TRIANGLES[code[t]][c]];
             faces[3 * (size_t)at + c] = vertex_of(keys, nk, edge_key(q[e[0]], q[e[1]]));
         }
         at += count;
@@ -100,27 +101,34 @@ int tcb_marching_tets_forward(const float *x, const float *s, int nv, const int3
     for (size_t i = 0; i < (size_t)nt * 4; i++)
         if (tets[i] < 0 || tets[i] >= nv)
             return tcb_fail(err, TCB_ERR_INPUT, "marching tets: tet %zu names vertex %d of %d", i / 4, tets[i], nv);
-    uint64_t *keys;
-    int nk = 0, rc = crossing_edges(s, tets, nt, &keys, &nk, err);
-    if (rc) return rc;
+    /* Each tet's occupancy code once: the passes below all read it. */
+    uint8_t *code = malloc((size_t)(nt > 0 ? nt : 1));
+    if (!code) return tcb_fail(err, TCB_ERR_NOMEM, "marching tets: out of memory for %d tets", nt);
     size_t nf = 0;
-    for (int t = 0; t < nt; t++) nf += (size_t)N_TRIANGLES[tet_code(s, tets + 4 * (size_t)t)];
-    out->verts = malloc(((size_t)nk * 3 + 1) * sizeof *out->verts);
-    out->edges = malloc(((size_t)nk * 2 + 1) * sizeof *out->edges);
-    out->faces = malloc((nf * 3 + 1) * sizeof *out->faces);
-    if (!out->verts || !out->edges || !out->faces) {
-        free(keys);
-        tcb_mt_surface_free(out);
-        return tcb_fail(err, TCB_ERR_NOMEM, "marching tets: out of memory for %zu faces", nf);
+    for (int t = 0; t < nt; t++) {
+        code[t] = (uint8_t)tet_code(s, tets + 4 * (size_t)t);
+        nf += (size_t)N_TRIANGLES[code[t]];
     }
-    for (int i = 0; i < nk; i++) {
+    uint64_t *keys = NULL;
+    int nk = 0, rc = crossing_edges(s, tets, code, nt, &keys, &nk, err);
+    if (!rc) {
+        out->verts = malloc(((size_t)nk * 3 + 1) * sizeof *out->verts);
+        out->edges = malloc(((size_t)nk * 2 + 1) * sizeof *out->edges);
+        out->faces = malloc((nf * 3 + 1) * sizeof *out->faces);
+        if (!out->verts || !out->edges || !out->faces)
+            rc = tcb_fail(err, TCB_ERR_NOMEM, "marching tets: out of memory for %zu faces", nf);
+    }
+    for (int i = 0; !rc && i < nk; i++) {
         int32_t a = (int32_t)(keys[i] >> 32), b = (int32_t)(keys[i] & 0xffffffffu);
         out->edges[2 * i] = a, out->edges[2 * i + 1] = b;
         edge_vertex(x, s, a, b, out->verts + 3 * (size_t)i);
     }
-    int at = add_faces(s, tets, nt, keys, nk, 1, out->faces, 0);
-    add_faces(s, tets, nt, keys, nk, 2, out->faces, at);
-    free(keys);
+    if (!rc) add_faces(tets, code, nt, keys, nk, 2, out->faces, add_faces(tets, code, nt, keys, nk, 1, out->faces, 0));
+    free(keys), free(code);
+    if (rc) {
+        tcb_mt_surface_free(out);
+        return rc;
+    }
     out->n_verts = nk, out->n_faces = (int)nf;
     return TCB_OK;
 }
