@@ -12,6 +12,7 @@
 #include "meshing/backend.h"
 #include "meshing/meshing_internal.h"
 #include "tcb/geometry.h"
+#include "tcb/locate.h"
 
 /* The module lives in the directory of the libtcbench that holds this code
  * (build tree or install prefix alike), so it is found by that path rather
@@ -279,3 +280,53 @@ int tcb_convex_offset(const float *pts, int n, double offset, tcb_mesh *out, tcb
     return rc;
 }
 
+
+/* Each face's outward unit normal and offset: the plane n·x = o. */
+static int face_planes(const tcb_mesh *m, double *planes, tcb_error *err)
+{
+    for (int f = 0; f < m->n_faces; f++) {
+        const int32_t *t = m->faces + 3 * f;
+        const float *a = m->verts + 3 * t[0], *b = m->verts + 3 * t[1], *c = m->verts + 3 * t[2];
+        double u[3], v[3];
+        for (int d = 0; d < 3; d++) u[d] = (double)b[d] - a[d], v[d] = (double)c[d] - a[d];
+        double nrm[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+        double len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+        if (!(len > 0)) return tcb_fail(err, TCB_ERR_INPUT, "meshing: face %d of the convex surface has no area", f);
+        double *p = planes + 4 * f;
+        for (int d = 0; d < 3; d++) p[d] = nrm[d] / len;
+        p[3] = p[0] * a[0] + p[1] * a[1] + p[2] * a[2];
+    }
+    return TCB_OK;
+}
+
+static int inside_planes(const double *planes, int nf, const float *q)
+{
+    for (int f = 0; f < nf; f++) {
+        const double *p = planes + 4 * f;
+        if (p[0] * q[0] + p[1] * q[1] + p[2] * q[2] > p[3]) return 0;
+    }
+    return 1;
+}
+
+int tcb_convex_signed_distance(const tcb_mesh *hull, const float *queries, int n, float *sd, tcb_error *err)
+{
+    int rc = tcb_meshing_check_mesh(hull, err);
+    if (rc) return rc;
+    if (n < 1 || !queries) return tcb_fail(err, TCB_ERR_INPUT, "meshing: %d query points", n);
+    if (!tcb_all_finite(queries, (size_t)3 * n))
+        return tcb_fail(err, TCB_ERR_NUMERIC, "meshing: a query point coordinate is not finite");
+    double *planes = malloc((size_t)hull->n_faces * 4 * sizeof *planes);
+    tcb_surface_point *loc = malloc((size_t)n * sizeof *loc);
+    if (!planes || !loc) {
+        free(planes), free(loc);
+        return tcb_fail(err, TCB_ERR_NOMEM, "meshing: out of memory for the distances of %d points", n);
+    }
+    rc = face_planes(hull, planes, err);
+    if (!rc) rc = tcb_mesh_locate(hull->verts, hull->n_verts, hull->faces, hull->n_faces, queries, n, loc, sd, err);
+    for (int i = 0; !rc && i < n; i++) {
+        float d = sqrtf(sd[i]);
+        sd[i] = inside_planes(planes, hull->n_faces, queries + 3 * i) ? -d : d;
+    }
+    free(planes), free(loc);
+    return rc;
+}

@@ -17,6 +17,7 @@ packages=(
   libopen3d-dev                           # meshing/: screened Poisson, quadric decimation, normals (Open3D 0.16)
   libsuitesparse-dev                      # meshing/: CHOLMOD's sparse Cholesky (Large-Steps systems)
   libcgal-dev                             # meshing/: CGAL's isotropic remeshing (PDG's template)
+  tetgen                                  # meshing/: the tetgen program fills DynoSurf's grid (a subprocess)
   libcmocka-dev                           # unit-test framework
   python3 python3-numpy python3-scipy     # tests: JSON comparisons, scipy reference for linear assignment
   python3-pip python3-venv python3-setuptools python3-wheel  # `pip install .` of the Python binding, offline

@@ -92,6 +92,14 @@ int tcb_convex_hull(const float *pts, int n, tcb_mesh *out, tcb_error *err);
 #define TCB_OFFSET_DIRECTIONS 200
 int tcb_convex_offset(const float *pts, int n, double offset, tcb_mesh *out, tcb_error *err);
 
+/* The signed distance of n queries [n][3] to a closed convex surface wound
+ * outward (tcb_convex_hull's output): the distance to the closest surface
+ * point (tcb_mesh_locate), negative inside — inside meaning on the inner
+ * side of every face's plane, which for a convex surface is the solid.
+ * DynoSurf pretrains its shape network to this field of the keyframe's
+ * hull. sd [n]. */
+int tcb_convex_signed_distance(const tcb_mesh *hull, const float *queries, int n, float *sd, tcb_error *err);
+
 #ifdef __cplusplus
 }
 #endif

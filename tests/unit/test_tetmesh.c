@@ -154,6 +154,42 @@ static double tet_volume(const tcb_tetmesh *t, int k)
     return (u[0] * (w[1] * z[2] - w[2] * z[1]) - u[1] * (w[0] * z[2] - w[2] * z[0]) + u[2] * (w[0] * z[1] - w[1] * z[0])) / 6;
 }
 
+/* The box's signed distance in closed form: outside, the length of the
+ * excess over the box; inside, minus the distance to the nearest face. */
+static double unit_box_signed_distance(const float *q)
+{
+    double out2 = 0, in = 1;
+    for (int d = 0; d < 3; d++) {
+        double e = fmax(fmax(q[d] - 1.0, -(double)q[d]), 0.0);
+        out2 += e * e;
+        in = fmin(in, fmin(q[d], 1.0 - q[d]));
+    }
+    return out2 > 0 ? sqrt(out2) : -in;
+}
+
+static void test_convex_signed_distance(void **state)
+{
+    (void)state;
+    tcb_mesh box = cube(0);
+    const int n = 4000;
+    float *q = malloc((size_t)n * 3 * sizeof *q), *sd = malloc((size_t)n * sizeof *sd);
+    tcb_rng rng;
+    tcb_rng_seed(&rng, 11);
+    for (int i = 0; i < 3 * n; i++) q[i] = (float)(2 * tcb_rng_uniform(&rng) - 0.5);
+    tcb_error err = {0};
+    assert_int_equal(tcb_convex_signed_distance(&box, q, n, sd, &err), TCB_OK);
+    int inside = 0;
+    for (int i = 0; i < n; i++) {
+        assert_float_equal(sd[i], unit_box_signed_distance(q + 3 * i), 1e-6);
+        inside += sd[i] < 0;
+    }
+    assert_true(inside > n / 16 && inside < n / 4); /* 1/8 of the volume */
+    q[7] = NAN;
+    assert_int_equal(tcb_convex_signed_distance(&box, q, n, sd, &err), TCB_ERR_NUMERIC);
+    free(q), free(sd);
+    tcb_mesh_free(&box);
+}
+
 static void test_tetrahedralize_cube(void **state)
 {
     (void)state;
@@ -242,6 +278,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_convex_hull),
         cmocka_unit_test(test_convex_offset),
+        cmocka_unit_test(test_convex_signed_distance),
         cmocka_unit_test(test_tetrahedralize_cube),
         cmocka_unit_test(test_tetrahedralize_errors),
     };
