@@ -1,9 +1,7 @@
 #!/usr/bin/env bash
 # neural/marching_tets.c against kaolin's marching_tetrahedra redone in
-# PyTorch (the steps of kaolin/ops/conversions/tetmesh.py, v0.14: torch.unique
-# over the valid tets' sorted edges, the crossing ones numbered in that
-# order, the interpolation weights flipped over s_a − s_b, faces gathered
-# from the 16-case table, one-triangle tets first), on TetGen's grid of the
+# PyTorch (tests/pytorch/dynosurf_torch.py: the steps of
+# kaolin/ops/conversions/tetmesh.py, v0.14), on TetGen's grid of the
 # unit cube with a noisy sphere's values: the same vertices (1e-6) in the
 # same order, the same faces, and autograd's gradient of Σ g·v in the
 # positions and the values against tcb_marching_tets_backward (1e-5).
@@ -21,9 +19,12 @@ for run in "0.0005 1" "0.002 2"; do
     mkdir -p "$out"
     "$TCB_MARCHING_TETS_DUMP" "$1" "$2" "$out"
     /usr/bin/python3 - "$out" <<'PY'
-import json, sys
+import json, os, sys
 import numpy as np
 import torch
+
+sys.path.insert(0, os.path.join(os.environ["TCB_SOURCE_DIR"], "tests", "pytorch"))
+from dynosurf_torch import marching_tetrahedra
 
 d = sys.argv[1]
 meta = json.load(open(d + "/meta.json"))
@@ -31,44 +32,6 @@ arr = lambda name, dtype, shape: torch.from_numpy(np.fromfile(d + "/" + name, dt
 x = arr("x.bin", np.float32, (meta["nv"], 3)).clone().requires_grad_(True)
 s = arr("s.bin", np.float32, (meta["nv"],)).clone().requires_grad_(True)
 tets = arr("tets.bin", np.int32, (meta["nt"], 4)).long()
-
-base_tet_edges = torch.tensor([0, 1, 0, 2, 0, 3, 1, 2, 1, 3, 2, 3])
-triangle_table = torch.tensor([
-    [-1, -1, -1, -1, -1, -1], [1, 0, 2, -1, -1, -1], [4, 0, 3, -1, -1, -1], [1, 4, 2, 1, 3, 4],
-    [3, 1, 5, -1, -1, -1], [2, 3, 0, 2, 5, 3], [1, 4, 0, 1, 5, 4], [4, 2, 5, -1, -1, -1],
-    [4, 5, 2, -1, -1, -1], [4, 1, 0, 4, 5, 1], [3, 2, 0, 3, 5, 2], [1, 3, 5, -1, -1, -1],
-    [4, 1, 2, 4, 3, 1], [3, 0, 4, -1, -1, -1], [2, 0, 1, -1, -1, -1], [-1, -1, -1, -1, -1, -1]])
-num_triangles_table = torch.tensor([0, 1, 1, 2, 1, 2, 2, 1, 1, 2, 2, 1, 2, 1, 1, 0])
-v_id = torch.pow(2, torch.arange(4))
-
-def marching_tetrahedra(pos, tet, sdf):
-    with torch.no_grad():
-        occ_n = sdf > 0
-        occ_fx4 = occ_n[tet.reshape(-1)].reshape(-1, 4)
-        occ_sum = occ_fx4.sum(-1)
-        valid_tets = (occ_sum > 0) & (occ_sum < 4)
-        all_edges = tet[valid_tets][:, base_tet_edges].reshape(-1, 2)
-        all_edges = torch.sort(all_edges, dim=1)[0]
-        unique_edges, idx_map = torch.unique(all_edges, dim=0, return_inverse=True)
-        mask_edges = occ_n[unique_edges.reshape(-1)].reshape(-1, 2).sum(-1) == 1
-        mapping = torch.ones(unique_edges.shape[0], dtype=torch.long) * -1
-        mapping[mask_edges] = torch.arange(int(mask_edges.sum()))
-        idx_map = mapping[idx_map]
-        interp_v = unique_edges[mask_edges]
-    edges_to_interp = pos[interp_v.reshape(-1)].reshape(-1, 2, 3)
-    edges_to_interp_sdf = sdf[interp_v.reshape(-1)].reshape(-1, 2, 1)
-    edges_to_interp_sdf = torch.cat([edges_to_interp_sdf[:, :1], -edges_to_interp_sdf[:, 1:]], 1)
-    denominator = edges_to_interp_sdf.sum(1, keepdim=True)
-    edges_to_interp_sdf = torch.flip(edges_to_interp_sdf, [1]) / denominator
-    verts = (edges_to_interp * edges_to_interp_sdf).sum(1)
-    idx_map = idx_map.reshape(-1, 6)
-    tetindex = (occ_fx4[valid_tets] * v_id.unsqueeze(0)).sum(-1)
-    num_triangles = num_triangles_table[tetindex]
-    faces = torch.cat((
-        torch.gather(idx_map[num_triangles == 1], 1, triangle_table[tetindex[num_triangles == 1]][:, :3]).reshape(-1, 3),
-        torch.gather(idx_map[num_triangles == 2], 1, triangle_table[tetindex[num_triangles == 2]][:, :6]).reshape(-1, 3),
-    ), dim=0)
-    return verts, faces
 
 verts, faces = marching_tetrahedra(x, tets, s)
 assert verts.shape[0] == meta["n"] and faces.shape[0] == meta["m"], (verts.shape, faces.shape, meta)

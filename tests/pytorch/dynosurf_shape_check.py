@@ -9,50 +9,26 @@ upstream gradients. Passes at 1e-4 relative (to each block's largest entry).
 
 usage: dynosurf_shape_check.py DYNOSURF_SHAPE_BINARY WORKDIR
 """
+import os
 import subprocess
 import sys
 
 import numpy as np
 import torch
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from dynosurf_torch import SHAPE_WIDTHS as WIDTHS, shape_forward, shape_net  # noqa: E402
+
 binary, work = sys.argv[1], sys.argv[2]
 N, EDGE, SEED = 64, 0.02, 5
-WIDTHS = [33, 128, 128, 128, 128, 128, 4]
 subprocess.run([binary, str(N), str(EDGE), str(SEED), work], check=True)
 load = lambda name, shape: torch.from_numpy(np.fromfile(f"{work}/{name}", dtype=np.float32).reshape(shape))
 
 
-class Embedder:
-    def __init__(self, multires):
-        self.freqs = 2.0 ** torch.linspace(0.0, multires - 1, multires)
-
-    def __call__(self, x):
-        out = [x]
-        for f in self.freqs:
-            out += [torch.sin(x * f), torch.cos(x * f)]
-        return torch.cat(out, -1)
-
-
-layers = []
-for i in range(len(WIDTHS) - 1):
-    layers.append(torch.nn.Linear(WIDTHS[i], WIDTHS[i + 1], bias=False))
-    if i < len(WIDTHS) - 2:
-        layers.append(torch.nn.LeakyReLU())
-net = torch.nn.Sequential(*layers)
-linears = [m for m in net if isinstance(m, torch.nn.Linear)]
 P = sum(a * b for a, b in zip(WIDTHS[:-1], WIDTHS[1:]))
-params = load("params.bin", (P,))
-at = 0
-with torch.no_grad():
-    for m in linears:
-        k = m.weight.numel()
-        m.weight.copy_(params[at:at + k].reshape(m.weight.shape))
-        at += k
-
+net, linears = shape_net(load("params.bin", (P,)))
 x = load("x.bin", (N, 3))
-out = net(Embedder(5)(x))
-sdf = out[:, 0]
-v = x + torch.tanh(out[:, 1:4]) * EDGE
+out, sdf, v = shape_forward(net, x, EDGE)
 (sdf * load("dsdf.bin", (N,))).sum().add((v * load("dv.bin", (N, 3))).sum()).backward()
 
 

@@ -19,16 +19,21 @@ static inline int export_path(char out[EXPORT_PATH_MAX], const char *dir, const 
     return 1;
 }
 
-/* DIR/NAME ← x[0..n); 0, or 1 with a message on stderr. */
-static inline int export_f32(const char *dir, const char *name, const float *x, size_t n)
+/* DIR/NAME ← n items of `size` bytes at x; 0, or 1 with a message on stderr. */
+static inline int export_raw(const char *dir, const char *name, const void *x, size_t size, size_t n)
 {
     char path[EXPORT_PATH_MAX];
     if (export_path(path, dir, name)) return 1;
     FILE *fp = fopen(path, "wb");
-    int ok = fp && fwrite(x, sizeof(float), n, fp) == n;
+    int ok = fp && fwrite(x, size, n, fp) == n;
     if (fp && fclose(fp)) ok = 0;
     if (!ok) fprintf(stderr, "cannot write %s\n", path);
     return ok ? 0 : 1;
+}
+
+static inline int export_f32(const char *dir, const char *name, const float *x, size_t n)
+{
+    return export_raw(dir, name, x, sizeof(float), n);
 }
 
 /* The model's weights as DIR/STEM.bin + DIR/STEM.json (tcb_atlas_model_export). */

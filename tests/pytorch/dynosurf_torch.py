@@ -1,0 +1,128 @@
+"""DynoSurf's pieces in PyTorch, written as the reference runs them
+(github yaoyx689/DynoSurf @ a2b7324) with the library calls it makes
+spelled out: the shape network (code/model/dmtet_network.py), kaolin's
+marching_tetrahedra (kaolin/ops/conversions/tetmesh.py, v0.14), pytorch3d's
+sample_points_from_meshes and chamfer_distance(norm=1) (v0.7.4), and the
+approximate SDF (code/loss.py approximate_sdf_loss). The tcbench checks
+import these; nothing here calls tcbench."""
+import torch
+
+SHAPE_WIDTHS = [33, 128, 128, 128, 128, 128, 4]
+
+
+class Embedder:
+    """The NeRF embedder: x, then sin and cos of x times 2^0 … 2^(multires−1)."""
+
+    def __init__(self, multires):
+        self.freqs = 2.0 ** torch.linspace(0.0, multires - 1, multires)
+
+    def __call__(self, x):
+        out = [x]
+        for f in self.freqs:
+            out += [torch.sin(x * f), torch.cos(x * f)]
+        return torch.cat(out, -1)
+
+
+def shape_net(params):
+    """The Decoder's bias-free layers with LeakyReLU, loaded from the flat
+    [out][in] weights; returns (the module, its Linear layers)."""
+    layers = []
+    for i in range(len(SHAPE_WIDTHS) - 1):
+        layers.append(torch.nn.Linear(SHAPE_WIDTHS[i], SHAPE_WIDTHS[i + 1], bias=False))
+        if i < len(SHAPE_WIDTHS) - 2:
+            layers.append(torch.nn.LeakyReLU())
+    net = torch.nn.Sequential(*layers)
+    linears = [m for m in net if isinstance(m, torch.nn.Linear)]
+    at = 0
+    with torch.no_grad():
+        for m in linears:
+            k = m.weight.numel()
+            m.weight.copy_(params[at:at + k].reshape(m.weight.shape))
+            at += k
+    assert at == params.numel()
+    return net, linears
+
+
+def shape_forward(net, x, edge):
+    """trainer.py: sdf = out[:, 0], v = x + tanh(out[:, 1:4]) · edge."""
+    out = net(Embedder(5)(x))
+    return out, out[:, 0], x + torch.tanh(out[:, 1:4]) * edge
+
+
+BASE_TET_EDGES = torch.tensor([0, 1, 0, 2, 0, 3, 1, 2, 1, 3, 2, 3])
+TRIANGLE_TABLE = torch.tensor([
+    [-1, -1, -1, -1, -1, -1], [1, 0, 2, -1, -1, -1], [4, 0, 3, -1, -1, -1], [1, 4, 2, 1, 3, 4],
+    [3, 1, 5, -1, -1, -1], [2, 3, 0, 2, 5, 3], [1, 4, 0, 1, 5, 4], [4, 2, 5, -1, -1, -1],
+    [4, 5, 2, -1, -1, -1], [4, 1, 0, 4, 5, 1], [3, 2, 0, 3, 5, 2], [1, 3, 5, -1, -1, -1],
+    [4, 1, 2, 4, 3, 1], [3, 0, 4, -1, -1, -1], [2, 0, 1, -1, -1, -1], [-1, -1, -1, -1, -1, -1]])
+NUM_TRIANGLES_TABLE = torch.tensor([0, 1, 1, 2, 1, 2, 2, 1, 1, 2, 2, 1, 2, 1, 1, 0])
+V_ID = torch.pow(2, torch.arange(4))
+
+
+def marching_tetrahedra(pos, tet, sdf):
+    """kaolin's steps: torch.unique over the valid tets' sorted edges, the
+    crossing ones numbered in that order, the interpolation weights flipped
+    over s_a − s_b, faces from the 16-case table, one-triangle tets first."""
+    with torch.no_grad():
+        occ_n = sdf > 0
+        occ_fx4 = occ_n[tet.reshape(-1)].reshape(-1, 4)
+        occ_sum = occ_fx4.sum(-1)
+        valid_tets = (occ_sum > 0) & (occ_sum < 4)
+        all_edges = tet[valid_tets][:, BASE_TET_EDGES].reshape(-1, 2)
+        all_edges = torch.sort(all_edges, dim=1)[0]
+        unique_edges, idx_map = torch.unique(all_edges, dim=0, return_inverse=True)
+        mask_edges = occ_n[unique_edges.reshape(-1)].reshape(-1, 2).sum(-1) == 1
+        mapping = torch.ones(unique_edges.shape[0], dtype=torch.long) * -1
+        mapping[mask_edges] = torch.arange(int(mask_edges.sum()))
+        idx_map = mapping[idx_map]
+        interp_v = unique_edges[mask_edges]
+    edges_to_interp = pos[interp_v.reshape(-1)].reshape(-1, 2, 3)
+    edges_to_interp_sdf = sdf[interp_v.reshape(-1)].reshape(-1, 2, 1)
+    edges_to_interp_sdf = torch.cat([edges_to_interp_sdf[:, :1], -edges_to_interp_sdf[:, 1:]], 1)
+    denominator = edges_to_interp_sdf.sum(1, keepdim=True)
+    edges_to_interp_sdf = torch.flip(edges_to_interp_sdf, [1]) / denominator
+    verts = (edges_to_interp * edges_to_interp_sdf).sum(1)
+    idx_map = idx_map.reshape(-1, 6)
+    tetindex = (occ_fx4[valid_tets] * V_ID.unsqueeze(0)).sum(-1)
+    num_triangles = NUM_TRIANGLES_TABLE[tetindex]
+    faces = torch.cat((
+        torch.gather(idx_map[num_triangles == 1], 1, TRIANGLE_TABLE[tetindex[num_triangles == 1]][:, :3]).reshape(-1, 3),
+        torch.gather(idx_map[num_triangles == 2], 1, TRIANGLE_TABLE[tetindex[num_triangles == 2]][:, :6]).reshape(-1, 3),
+    ), dim=0)
+    return verts, faces
+
+
+def sample_points(verts, faces, face_idx, w):
+    """sample_points_from_meshes(return_normals=True) for given draws: the
+    points w0 a + w1 b + w2 c and their faces' unit normals
+    (b − a) × (c − b), normalised with eps 1e-6 as pytorch3d does."""
+    a, b, c = (verts[faces[face_idx, k]] for k in range(3))
+    pts = w[:, :1] * a + w[:, 1:2] * b + w[:, 2:3] * c
+    n = torch.nn.functional.normalize(torch.cross(b - a, c - b, dim=1), eps=1e-6, dim=1)
+    return pts, n
+
+
+def _cos_term(a, b):
+    return 1 - torch.nn.functional.cosine_similarity(a, b, dim=1, eps=1e-6).abs()
+
+
+def chamfer_l1(x, nx, y, ny):
+    """chamfer_distance(x, y, x_normals, y_normals, norm=1): the L1-nearest
+    neighbours both ways (exact, by a full distance matrix), means over
+    points, 1 − |cos| for the normals."""
+    d = torch.cdist(x.detach().double(), y.detach().double(), p=1)
+    to_y, to_x = d.argmin(1), d.argmin(0)
+    cham = (x - y[to_y]).abs().sum(1).mean() + (y - x[to_x]).abs().sum(1).mean()
+    normal = _cos_term(nx, ny[to_y]).mean() + _cos_term(ny, nx[to_x]).mean()
+    return cham, normal
+
+
+def approx_sdf(v, p, n, k=10, r=0.1):
+    """approximate_sdf_loss's target: over the k nearest points,
+    softmax(exp(−d²/r²)) weights of n·(v − p)."""
+    d2 = torch.cdist(v.detach().double(), p.double()) ** 2
+    idx = d2.topk(k, dim=1, largest=False).indices
+    diff = v[:, None, :] - p[idx]
+    pp = diff.norm(dim=-1)
+    w = torch.softmax(torch.exp(-pp ** 2 / (r * r)), dim=-1)
+    return (w * (n[idx] * diff).sum(-1)).sum(-1)
