@@ -16,7 +16,7 @@
 
 #include <stddef.h>
 
-#include "neural/layers.h"
+#include "neural/mlp.h"
 #include "tcb/error.h"
 
 #define DYNO_SHAPE_FREQS 5
@@ -27,7 +27,7 @@
 #define DYNO_LEAKY_SLOPE 0.01f
 
 typedef struct dyno_shape {
-    tcb_linear layer[DYNO_SHAPE_LAYERS];
+    tcb_mlp net;
 } dyno_shape;
 
 /* Floats in the flat parameter buffer. */
@@ -42,10 +42,9 @@ void dyno_shape_init(const dyno_shape *s, struct tcb_rng *rng);
 /* What the backward pass needs of a forward over n vertices. */
 typedef struct dyno_shape_acts {
     int n;
-    float *enc;                          /* [n][33] */
-    float *h[DYNO_SHAPE_LAYERS - 1];     /* [n][128] after each LeakyReLU */
-    float *out;                          /* [n][4] */
-    float *dh[2];                        /* [n][128] backward scratch */
+    float *enc;       /* [n][33] */
+    tcb_mlp_acts mlp; /* [n][128] after each LeakyReLU */
+    float *out;       /* [n][4] */
 } dyno_shape_acts;
 
 int dyno_shape_acts_alloc(dyno_shape_acts *a, int n, tcb_error *err);
