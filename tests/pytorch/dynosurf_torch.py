@@ -24,23 +24,8 @@ class Embedder:
 
 
 def shape_net(params):
-    """The Decoder's bias-free layers with LeakyReLU, loaded from the flat
-    [out][in] weights; returns (the module, its Linear layers)."""
-    layers = []
-    for i in range(len(SHAPE_WIDTHS) - 1):
-        layers.append(torch.nn.Linear(SHAPE_WIDTHS[i], SHAPE_WIDTHS[i + 1], bias=False))
-        if i < len(SHAPE_WIDTHS) - 2:
-            layers.append(torch.nn.LeakyReLU())
-    net = torch.nn.Sequential(*layers)
-    linears = [m for m in net if isinstance(m, torch.nn.Linear)]
-    at = 0
-    with torch.no_grad():
-        for m in linears:
-            k = m.weight.numel()
-            m.weight.copy_(params[at:at + k].reshape(m.weight.shape))
-            at += k
-    assert at == params.numel()
-    return net, linears
+    """The Decoder's bias-free layers with LeakyReLU (slope 0.01)."""
+    return mlp(params, SHAPE_WIDTHS, 0.01)
 
 
 def shape_forward(net, x, edge):
@@ -126,3 +111,71 @@ def approx_sdf(v, p, n, k=10, r=0.1):
     pp = diff.norm(dim=-1)
     w = torch.softmax(torch.exp(-pp ** 2 / (r * r)), dim=-1)
     return (w * (n[idx] * diff).sum(-1)).sum(-1)
+
+
+def mlp(params, widths, slope, dtype=torch.float32):
+    """Bias-free Linear layers with (Leaky)ReLU between them, loaded from
+    the flat [out][in] weights; returns (the module, its Linear layers)."""
+    layers = []
+    for i in range(len(widths) - 1):
+        layers.append(torch.nn.Linear(widths[i], widths[i + 1], bias=False, dtype=dtype))
+        if i < len(widths) - 2:
+            layers.append(torch.nn.LeakyReLU(slope) if slope > 0 else torch.nn.ReLU())
+    net = torch.nn.Sequential(*layers)
+    linears = [m for m in net if isinstance(m, torch.nn.Linear)]
+    at = 0
+    with torch.no_grad():
+        for m in linears:
+            k = m.weight.numel()
+            m.weight.copy_(params[at:at + k].reshape(m.weight.shape))
+            at += k
+    assert at == params.numel()
+    return net, linears
+
+
+TRANSFORM_WIDTHS = [20, 128, 128, 128, 128, 128, 6]
+BLEND_WIDTHS = [6, 128, 128, 128, 128, 128, 1]
+
+
+def so3_exp(r):
+    """LieAlgebra/so3.py exp: R = I + sinc1(θ) W + sinc2(θ) W², with the
+    reference's series below θ = 0.01 (sinc.py)."""
+    theta = r.norm(dim=-1, keepdim=True)[..., None]
+    small = theta < 0.01
+    t2 = theta * theta
+    safe = torch.where(small, torch.ones_like(theta), theta)
+    a = torch.where(small, 1 - t2 / 6 * (1 - t2 / 20 * (1 - t2 / 42)), torch.sin(safe) / safe)
+    b = torch.where(small, 0.5 * (1 - t2 / 12 * (1 - t2 / 30 * (1 - t2 / 56))), (1 - torch.cos(safe)) / (safe * safe))
+    zero = torch.zeros_like(r[..., 0])
+    W = torch.stack([torch.stack([zero, -r[..., 2], r[..., 1]], -1),
+                     torch.stack([r[..., 2], zero, -r[..., 0]], -1),
+                     torch.stack([-r[..., 1], r[..., 0], zero], -1)], -2)
+    eye = torch.eye(3, dtype=r.dtype).expand_as(W)
+    return eye + a * W + b * (W @ W)
+
+
+def deformer_transforms(control, transform_net, frames):
+    """ControlPts_deformer: raw [F][K][6] = MLP_T(posenc([t, c_k], 2)), R = exp(raw[..., :3])."""
+    K = control.shape[0]
+    t = torch.tensor(frames, dtype=control.dtype)[:, None, None].expand(len(frames), K, 1)
+    tc = torch.cat([t, control[None].expand(len(frames), K, 3)], -1)
+    raw = transform_net(Embedder(2)(tc))
+    return raw, so3_exp(raw[..., :3])
+
+
+def deformer_weights(control, blend_net, x):
+    """softmax_k MLP_W([x, x − c_k]) [n][K]."""
+    K = control.shape[0]
+    xe = x[:, None, :].expand(x.shape[0], K, 3)
+    return torch.softmax(blend_net(torch.cat([xe, xe - control[None]], -1))[..., 0], -1)
+
+
+def deform(x, w, R, raw):
+    """Σ_k w_k (R_k x + T_k) for one frame: x [n][3], R [K][3][3], raw [K][6]."""
+    moved = torch.einsum("kab,nb->nka", R, x) + raw[None, :, 3:]
+    return (w[..., None] * moved).sum(1)
+
+
+def gaussian_weights(control, x, sigma=0.1):
+    d2 = ((x[:, None, :] - control[None]) ** 2).sum(-1)
+    return torch.softmax(-d2 / (2 * sigma * sigma), -1)
