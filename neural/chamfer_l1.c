@@ -1,5 +1,7 @@
 #include "neural/chamfer_l1.h"
 
+#include "neural/abs_cos.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -53,23 +55,6 @@ int tcb_nearest_l1(const tcb_nn *index, const float *pts, int n, const float *qu
 
 static double sgn(double v) { return (v > 0) - (v < 0); }
 
-/* 1 − |cos(a, b)|, and ∂/∂a added to da (scaled by s) when da is given. */
-static double normal_term(const float *a, const float *b, double s, float *da)
-{
-    double ab = 0, aa = 0, bb = 0;
-    for (int d = 0; d < 3; d++) ab += (double)a[d] * b[d], aa += (double)a[d] * a[d], bb += (double)b[d] * b[d];
-    double na = sqrt(aa), nb = sqrt(bb), den = na * nb;
-    double c = ab / fmax(den, TCB_CHAMFER_COS_EPS);
-    if (da) {
-        if (den > TCB_CHAMFER_COS_EPS) {
-            for (int d = 0; d < 3; d++) da[d] -= (float)(s * sgn(c) * (b[d] / den - c * a[d] / aa));
-        } else {
-            for (int d = 0; d < 3; d++) da[d] -= (float)(s * sgn(c) * b[d] / TCB_CHAMFER_COS_EPS);
-        }
-    }
-    return 1 - fabs(c);
-}
-
 int tcb_chamfer_l1(const float *X, const float *NX, int nx, const float *Y, const float *NY, int ny,
                    const tcb_nn *y_index, double *cham, double *normal, float *dX, float *dNX, tcb_error *err)
 {
@@ -89,14 +74,14 @@ int tcb_chamfer_l1(const float *X, const float *NX, int nx, const float *Y, cons
             const float *x = X + 3 * i, *y = Y + 3 * to_y[i];
             *cham += sx * l1(x, y);
             for (int d = 0; d < 3; d++) dX[3 * i + d] += (float)(sx * sgn((double)x[d] - y[d]));
-            if (with_normals) *normal += sx * normal_term(NX + 3 * i, NY + 3 * to_y[i], sx, dNX ? dNX + 3 * i : NULL);
+            if (with_normals) *normal += sx * tcb_abs_cos_term(NX + 3 * i, NY + 3 * to_y[i], sx, dNX ? dNX + 3 * i : NULL);
         }
         for (int j = 0; j < ny; j++) {
             int i = to_x[j];
             const float *x = X + 3 * i, *y = Y + 3 * j;
             *cham += sy * l1(x, y);
             for (int d = 0; d < 3; d++) dX[3 * i + d] += (float)(sy * sgn((double)x[d] - y[d]));
-            if (with_normals) *normal += sy * normal_term(NX + 3 * i, NY + 3 * j, sy, dNX ? dNX + 3 * i : NULL);
+            if (with_normals) *normal += sy * tcb_abs_cos_term(NX + 3 * i, NY + 3 * j, sy, dNX ? dNX + 3 * i : NULL);
         }
     }
     tcb_nn_free(x_index);

@@ -8,7 +8,7 @@
  *   i → j(i)  the nearest y to x_i in the L1 metric (and j → i(j) back)
  *   cham   = mean_i |x_i − y_j(i)|₁ + mean_j |y_j − x_i(j)|₁
  *   normal = mean_i (1 − |cos(nx_i, ny_j(i))|) + mean_j (1 − |cos(ny_j, nx_i(j))|)
- *   cos(a, b) = a·b / max(|a||b|, 1e-6)
+ *   cos(a, b) = a·b / max(|a||b|, 1e-6)   (neural/abs_cos.h)
  *
  * The gradient goes to X and NX (Y is data): ∂|d|₁/∂d = sign(d) (0 at 0,
  * as torch's abs). The nearest neighbours are exact: the L1-nearest point
@@ -24,7 +24,6 @@
 #include "tcb/nn.h"
 
 #define TCB_CHAMFER_L1_CANDIDATES 16
-#define TCB_CHAMFER_COS_EPS 1e-6
 
 /* For each query, idx = its L1-nearest of pts (tcb_nn index over them;
  * ties to the lowest index) and d1 = that distance (may be NULL). */

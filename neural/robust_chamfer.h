@@ -19,4 +19,13 @@
 int tcb_robust_chamfer(const float *X, int nx, const float *P, int np, const tcb_nn *points_index, double alpha,
                        double *cd, float *dX, tcb_error *err);
 
+/* The same with DynoSurf's normal term beside it (code/loss.py L97-139):
+ *   *normal = mean_{x∈X} (1 − |cos(n_x, n_p(x))|) + mean_{p∈P} (1 − |cos(n_p, n_x(p))|)
+ * (neural/abs_cos.h) over the same nearest neighbours, its gradient in NX
+ * [nx][3] into dNX (overwrites; NULL: none). NX and NP NULL: no normal
+ * term, *normal (may be NULL) 0. */
+int tcb_robust_chamfer_normals(const float *X, const float *NX, int nx, const float *P, const float *NP, int np,
+                               const tcb_nn *points_index, double alpha, double *cd, double *normal, float *dX,
+                               float *dNX, tcb_error *err);
+
 #endif
