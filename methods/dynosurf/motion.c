@@ -1,0 +1,239 @@
+/* DynoSurf's stage 2 (methods/dynosurf/motion.h). */
+#include "methods/dynosurf/motion.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "neural/approx_sdf.h"
+#include "neural/robust_chamfer.h"
+#include "tcb/rng.h"
+
+enum { K = DYNO_CONTROL_POINTS };
+
+int dyno_motion_fit_init(dyno_motion_fit *f, const dyno_motion_data *data, tcb_error *err)
+{
+    memset(f, 0, sizeof *f);
+    f->data = *data;
+    dyno_motion_data *d = &f->data;
+    if (d->n_grid_samples > d->n_grid) d->n_grid_samples = d->n_grid;
+    for (int t = 0; t < d->n_frames; t++)
+        if (d->n_pts[t] < TCB_APPROX_SDF_K)
+            return tcb_fail(err, TCB_ERR_INPUT, "dynosurf: frame %d has %d points, need at least %d", t, d->n_pts[t],
+                            TCB_APPROX_SDF_K);
+    size_t F = (size_t)d->n_frames, m = (size_t)d->n_template, g = (size_t)d->n_grid_samples,
+           ms = (size_t)d->n_samples;
+    f->frames = malloc(F * sizeof *f->frames), f->perm = malloc((size_t)d->n_grid * sizeof *f->perm);
+    f->X = malloc(F * m * 3 * sizeof(float)), f->dX = malloc(F * m * 3 * sizeof(float));
+    f->y = malloc(g * 3 * sizeof(float)), f->yhat = malloc(g * sizeof(float));
+    f->Y = malloc(F * g * 3 * sizeof(float)), f->dY = malloc(F * g * 3 * sizeof(float));
+    f->s = malloc(F * g * sizeof(float)), f->ds = malloc(F * g * sizeof(float));
+    f->nbr = malloc(F * g * TCB_APPROX_SDF_K * sizeof(int32_t));
+    f->draws = malloc(F * ms * sizeof *f->draws);
+    f->xs = malloc(ms * 3 * sizeof(float)), f->nxs = malloc(ms * 3 * sizeof(float));
+    f->dxs = malloc(ms * 3 * sizeof(float)), f->dnxs = malloc(ms * 3 * sizeof(float));
+    f->face_grad = malloc((size_t)d->n_faces * 3 * sizeof(float));
+    int ok = f->frames && f->perm && f->X && f->dX && f->y && f->yhat && f->Y && f->dY && f->s && f->ds && f->nbr &&
+             f->draws && f->xs && f->nxs && f->dxs && f->dnxs && f->face_grad;
+    int rc = ok ? dyno_blend_alloc(&f->bt, d->n_template, err)
+                : tcb_fail(err, TCB_ERR_NOMEM, "dynosurf: out of memory for stage 2 over %d frames", d->n_frames);
+    if (!rc) rc = dyno_blend_alloc(&f->bg, d->n_grid_samples, err);
+    if (!rc) rc = dyno_transforms_alloc(&f->tr, d->n_frames, err);
+    if (rc) {
+        dyno_motion_fit_free(f);
+        return rc;
+    }
+    for (int t = 0; t < d->n_frames; t++) f->frames[t] = t;
+    for (int i = 0; i < d->n_grid; i++) f->perm[i] = i;
+    return TCB_OK;
+}
+
+void dyno_motion_fit_free(dyno_motion_fit *f)
+{
+    dyno_blend_free(&f->bt), dyno_blend_free(&f->bg), dyno_transforms_free(&f->tr);
+    free(f->frames), free(f->perm), free(f->X), free(f->dX), free(f->y), free(f->yhat), free(f->Y), free(f->dY);
+    free(f->s), free(f->ds), free(f->nbr), free(f->draws), free(f->xs), free(f->nxs), free(f->dxs), free(f->dnxs);
+    free(f->face_grad);
+    memset(f, 0, sizeof *f);
+}
+
+/* g grid vertices without replacement (a partial Fisher–Yates shuffle of
+ * f->perm), their positions and SDF values. */
+static void pick_grid(dyno_motion_fit *f, struct tcb_rng *rng)
+{
+    const dyno_motion_data *d = &f->data;
+    for (int i = 0; i < d->n_grid_samples; i++) {
+        int j = i + (int)tcb_rng_below(rng, (uint32_t)(d->n_grid - i));
+        int32_t keep = f->perm[i];
+        f->perm[i] = f->perm[j], f->perm[j] = keep;
+        memcpy(f->y + 3 * (size_t)i, d->grid_v + 3 * (size_t)f->perm[i], 3 * sizeof(float));
+        f->yhat[i] = d->grid_sdf[f->perm[i]];
+    }
+}
+
+/* X and Y of every frame from the current deformer. */
+static void deform_all(dyno_motion_fit *f, const dyno_deformer *dfm)
+{
+    const dyno_motion_data *d = &f->data;
+    size_t m = (size_t)d->n_template, g = (size_t)d->n_grid_samples;
+    dyno_blend_forward(dfm, &f->bt, d->template_verts, d->n_template);
+    dyno_blend_forward(dfm, &f->bg, f->y, d->n_grid_samples);
+    dyno_transforms_forward(dfm, &f->tr, f->frames, d->n_frames);
+    for (int t = 0; t < d->n_frames; t++) {
+        const float *R = f->tr.R + 9 * K * t, *raw = f->tr.raw + 6 * K * t;
+        dyno_deform_apply(d->template_verts, d->n_template, f->bt.w, R, raw, f->X + 3 * m * t);
+        dyno_deform_apply(f->y, d->n_grid_samples, f->bg.w, R, raw, f->Y + 3 * g * t);
+    }
+}
+
+/* The robust Chamfer and normal terms, means over frames; their gradient
+ * (weighted) into f->dX through the samples. */
+static int chamfer_terms(dyno_motion_fit *f, struct tcb_rng *rng, dyno_motion_terms *t, tcb_error *err)
+{
+    const dyno_motion_data *d = &f->data;
+    size_t m = (size_t)d->n_template;
+    int ms = d->n_samples;
+    float wc = (float)(d->weights.chamfer / d->n_frames), wn = (float)(d->weights.normal / d->n_frames);
+    for (int u = 0; u < d->n_frames; u++) {
+        const float *X = f->X + 3 * m * u;
+        tcb_mesh_draw *draws = f->draws + (size_t)ms * u;
+        int rc = tcb_mesh_sample_draw(X, d->faces, d->n_faces, ms, rng, draws, err);
+        if (rc) return rc;
+        tcb_mesh_sample_forward(X, d->faces, draws, ms, f->xs, f->nxs);
+        double cd, normal;
+        rc = tcb_robust_chamfer_normals(f->xs, f->nxs, ms, d->pts[u], d->normals[u], d->n_pts[u], d->index[u],
+                                        TCB_ROBUST_CHAMFER_ALPHA, &cd, &normal, f->dxs, f->dnxs, err);
+        if (rc) return rc;
+        t->chamfer += cd / d->n_frames, t->normal += normal / d->n_frames;
+        for (size_t i = 0; i < 3 * (size_t)ms; i++) f->dxs[i] *= wc, f->dnxs[i] *= wn;
+        tcb_mesh_sample_backward(X, d->faces, d->n_faces, draws, ms, f->dxs, f->dnxs, f->face_grad,
+                                 f->dX + 3 * m * u);
+    }
+    return TCB_OK;
+}
+
+/* Σ raw² over the keyframe's transforms; its gradient into tr.draw. */
+static double identity_term(dyno_motion_fit *f)
+{
+    const float *raw = f->tr.raw + 6 * K * f->data.key;
+    float *draw = f->tr.draw + 6 * K * f->data.key;
+    double sum = 0;
+    for (int i = 0; i < 6 * K; i++) {
+        sum += (double)raw[i] * raw[i];
+        draw[i] += (float)(2 * f->data.weights.identity * raw[i]);
+    }
+    return sum;
+}
+
+static double sigmoid(double z) { return 1 / (1 + exp(-z)); }
+
+/* The SDF-sign term; its gradient into f->dY. */
+static int sdf_sign_term(dyno_motion_fit *f, double *value, tcb_error *err)
+{
+    const dyno_motion_data *d = &f->data;
+    int F = d->n_frames, g = d->n_grid_samples;
+    for (int u = 0; u < F; u++) {
+        int rc = tcb_approx_sdf_forward(f->s + (size_t)g * u, f->nbr + (size_t)g * u * TCB_APPROX_SDF_K,
+                                        f->Y + 3 * (size_t)g * u, g, d->index[u], d->pts[u], d->normals[u],
+                                        TCB_APPROX_SDF_K, TCB_APPROX_SDF_RADIUS, err);
+        if (rc) return rc;
+    }
+    const double scale = 1.0 / (2 * DYNO_FUSION_THRES * DYNO_FUSION_THRES), mean = 1.0 / ((double)F * g);
+    double sum = 0, *rho = malloc((size_t)F * sizeof *rho);
+    if (!rho) return tcb_fail(err, TCB_ERR_NOMEM, "dynosurf: out of memory");
+    for (int n = 0; n < g; n++) {
+        double top = -INFINITY, z = 0;
+        for (int u = 0; u < F; u++) {
+            double s = f->s[(size_t)g * u + n];
+            rho[u] = -s * s * scale, top = fmax(top, rho[u]);
+        }
+        for (int u = 0; u < F; u++) z += rho[u] = exp(rho[u] - top);
+        double target = sigmoid(DYNO_SIGMOID_SCALE * f->yhat[n]);
+        for (int u = 0; u < F; u++) {
+            size_t i = (size_t)g * u + n;
+            double r = rho[u] / z, sg = sigmoid(DYNO_SIGMOID_SCALE * f->s[i]), diff = r * target - r * sg;
+            sum += fabs(diff) * mean;
+            double sign = (diff > 0) - (diff < 0);
+            f->ds[i] = (float)(-d->weights.sdf_sign * mean * sign * r * sg * (1 - sg) * DYNO_SIGMOID_SCALE);
+        }
+    }
+    free(rho);
+    *value = sum;
+    for (int u = 0; u < F; u++)
+        tcb_approx_sdf_backward(f->dY + 3 * (size_t)g * u, f->ds + (size_t)g * u, f->Y + 3 * (size_t)g * u, g,
+                                f->nbr + (size_t)g * u * TCB_APPROX_SDF_K, d->pts[u], d->normals[u], TCB_APPROX_SDF_K,
+                                TCB_APPROX_SDF_RADIUS);
+    return TCB_OK;
+}
+
+/* The temporal smoothness of the edges; its gradient into f->dX. */
+static double smooth_term(dyno_motion_fit *f)
+{
+    const dyno_motion_data *d = &f->data;
+    size_t m = (size_t)d->n_template;
+    double sum = 0, scale = d->weights.smooth / (3.0 * d->n_faces);
+    static const int edges[3][2] = {{0, 1}, {1, 2}, {0, 2}};
+    for (int t = 0; t < d->n_frames; t++) {
+        int nbrs[2] = {t > 0 ? t - 1 : 0, t + 1 < d->n_frames ? t + 1 : d->n_frames - 1};
+        for (int j = 0; j < 2; j++) {
+            int u = nbrs[j];
+            if (u == t) continue; /* D = 0 at the clip's ends */
+            const float *Xt = f->X + 3 * m * t, *Xu = f->X + 3 * m * u;
+            float *dXt = f->dX + 3 * m * t, *dXu = f->dX + 3 * m * u;
+            for (int q = 0; q < d->n_faces; q++)
+                for (int e = 0; e < 3; e++) {
+                    size_t a = 3 * (size_t)d->faces[3 * q + edges[e][0]], b = 3 * (size_t)d->faces[3 * q + edges[e][1]];
+                    for (int c = 0; c < 3; c++) {
+                        double diff = ((double)Xu[a + c] - Xt[a + c]) - ((double)Xu[b + c] - Xt[b + c]);
+                        sum += diff * diff;
+                        float gr = (float)(2 * scale * diff);
+                        dXu[a + c] += gr, dXu[b + c] -= gr, dXt[a + c] -= gr, dXt[b + c] += gr;
+                    }
+                }
+        }
+    }
+    return sum / (3.0 * d->n_faces);
+}
+
+int dyno_motion_loss(dyno_motion_fit *f, const dyno_deformer *dfm, const dyno_deformer *grad, struct tcb_rng *rng,
+                     dyno_motion_terms *t, tcb_error *err)
+{
+    const dyno_motion_data *d = &f->data;
+    int F = d->n_frames;
+    size_t m = (size_t)d->n_template, g = (size_t)d->n_grid_samples;
+    memset(t, 0, sizeof *t);
+    pick_grid(f, rng);
+    deform_all(f, dfm);
+    memset(f->dX, 0, (size_t)F * m * 3 * sizeof(float));
+    memset(f->tr.dR, 0, (size_t)F * K * 9 * sizeof(float));
+    memset(f->tr.draw, 0, (size_t)F * K * 6 * sizeof(float));
+    memset(f->bt.dw, 0, m * K * sizeof(float));
+    memset(f->bg.dw, 0, g * K * sizeof(float));
+    int rc = chamfer_terms(f, rng, t, err);
+    if (!rc) rc = sdf_sign_term(f, &t->sdf_sign, err);
+    if (rc) return rc;
+    t->identity = identity_term(f);
+    t->smooth = smooth_term(f);
+    const dyno_motion_weights *w = &d->weights;
+    t->total = w->chamfer * t->chamfer + w->normal * t->normal + w->identity * t->identity +
+               w->sdf_sign * t->sdf_sign + w->smooth * t->smooth;
+    for (int u = 0; u < F; u++) {
+        const float *R = f->tr.R + 9 * K * u, *raw = f->tr.raw + 6 * K * u;
+        float *dR = f->tr.dR + 9 * K * u, *draw = f->tr.draw + 6 * K * u;
+        dyno_deform_apply_backward(d->template_verts, d->n_template, f->bt.w, R, raw, f->dX + 3 * m * u, dR, draw,
+                                   f->bt.dw);
+        dyno_deform_apply_backward(f->y, d->n_grid_samples, f->bg.w, R, raw, f->dY + 3 * g * u, dR, draw, f->bg.dw);
+    }
+    dyno_transforms_backward(dfm, grad, &f->tr);
+    dyno_blend_backward(dfm, grad, &f->bt);
+    dyno_blend_backward(dfm, grad, &f->bg);
+    return TCB_OK;
+}
+
+void dyno_motion_frame(dyno_motion_fit *f, const dyno_deformer *dfm, int t, float *X)
+{
+    const dyno_motion_data *d = &f->data;
+    dyno_blend_forward(dfm, &f->bt, d->template_verts, d->n_template);
+    dyno_transforms_forward(dfm, &f->tr, &f->frames[t], 1);
+    dyno_deform_apply(d->template_verts, d->n_template, f->bt.w, f->tr.R, f->tr.raw, X);
+}
