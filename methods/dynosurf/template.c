@@ -12,7 +12,8 @@ int dyno_template_fit_init(dyno_template_fit *f, const tcb_tetmesh *grid, float 
                            const float *normals, int n_pts, const tcb_nn *index, int n_samples, tcb_error *err)
 {
     *f = (dyno_template_fit){.grid = grid, .edge = edge, .pts = pts, .normals = normals, .n_pts = n_pts,
-                             .index = index, .n_samples = n_samples};
+                             .index = index, .n_samples = n_samples,
+                             .weights = DYNO_TEMPLATE_WEIGHTS};
     if (n_pts < TCB_APPROX_SDF_K)
         return tcb_fail(err, TCB_ERR_INPUT, "dynosurf: the keyframe has %d points, need at least %d", n_pts,
                         TCB_APPROX_SDF_K);
@@ -82,7 +83,7 @@ static int sdf_term(dyno_template_fit *f, double *value, tcb_error *err)
     int rc = tcb_approx_sdf_forward(f->s, f->nbr, f->v, nv, f->index, f->pts, f->normals, TCB_APPROX_SDF_K,
                                     TCB_APPROX_SDF_RADIUS, err);
     if (rc) return rc;
-    double sum = 0, scale = DYNO_W_SDF / nv;
+    double sum = 0, scale = f->weights.sdf / nv;
     for (int i = 0; i < nv; i++) {
         double r = (double)f->sdf[i] - f->s[i];
         sum += fabs(r);
@@ -109,7 +110,7 @@ static int surface_terms(dyno_template_fit *f, const tcb_mt_surface *surf, struc
                         f->dnx, err);
     if (rc) return rc;
     for (size_t i = 0; i < 3 * (size_t)m; i++)
-        f->dx[i] *= (float)DYNO_W_CHAMFER, f->dnx[i] *= (float)DYNO_W_NORMAL;
+        f->dx[i] *= (float)f->weights.chamfer, f->dnx[i] *= (float)f->weights.normal;
     float *dverts = calloc((size_t)surf->n_verts * 3, sizeof *dverts);
     float *face_grad = malloc((size_t)surf->n_faces * 3 * sizeof *face_grad);
     if (!dverts || !face_grad) {
@@ -139,7 +140,7 @@ int dyno_template_loss(dyno_template_fit *f, const dyno_shape *s, const dyno_sha
     if (!rc) rc = surface_terms(f, &surf, rng, t, err);
     tcb_mt_surface_free(&surf);
     if (rc) return rc;
-    t->total = DYNO_W_CHAMFER * t->chamfer + DYNO_W_NORMAL * t->normal + DYNO_W_SDF * t->sdf;
+    t->total = f->weights.chamfer * t->chamfer + f->weights.normal * t->normal + f->weights.sdf * t->sdf;
     dyno_shape_readout_backward(f->acts.out, f->grid->n_verts, f->edge, f->dsdf, f->dv, f->dout);
     dyno_shape_backward(s, grad, &f->acts, f->dout);
     return TCB_OK;

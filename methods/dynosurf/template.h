@@ -30,9 +30,12 @@
 #include "tcb/tetmesh.h"
 
 #define DYNO_TEMPLATE_SAMPLES 10000
-#define DYNO_W_CHAMFER 500.0
-#define DYNO_W_NORMAL 0.001
-#define DYNO_W_SDF 50.0
+
+/* Stage 1's weights: the reference's are DYNO_TEMPLATE_WEIGHTS. */
+typedef struct dyno_template_weights {
+    double chamfer, normal, sdf;
+} dyno_template_weights;
+#define DYNO_TEMPLATE_WEIGHTS ((dyno_template_weights){500.0, 0.001, 50.0})
 
 struct tcb_rng;
 
@@ -45,6 +48,7 @@ typedef struct dyno_template_fit {
     int n_pts;
     const tcb_nn *index;        /* over pts */
     int n_samples;
+    dyno_template_weights weights; /* DYNO_TEMPLATE_WEIGHTS after init */
     dyno_shape_acts acts;
     float *sdf, *v;             /* [nv], [nv][3] */
     float *dsdf, *dv, *dout;    /* [nv], [nv][3], [nv][4] */

@@ -5,10 +5,11 @@ C side's weights, grid, points and surface draws
   pretraining  MSELoss(sdf, the hull's signed distance) and its gradient;
   stage 1      the template by marching tetrahedra (the same faces), the
                L1 Chamfer, normal and approximate-SDF terms, their weighted
-               sum, autograd's weight gradient, and torch.optim.Adam's
-               first step at lr 1e-4.
+               sum, autograd's weight gradient (the sum's and each term's),
+               and torch.optim.Adam's first step at lr 1e-4.
 Passes at 1e-4 relative (each block to its largest entry; the terms to
-their value).
+their value); each term's own gradient at 1e-3 (a wrong formula is off by
+its own size; the small terms' float rounding is nearer 1e-4).
 
 usage: dynosurf_template_check.py HELPER_BINARY WORKDIR
 """
@@ -71,7 +72,14 @@ assert (verts.shape[0], faces.shape[0]) == (meta["n_verts"], meta["n_faces"]), (
 samples, normals = sample_points(verts, faces, load("draw_face.bin", (M,), np.int32).long(), load("draw_w.bin", (M, 3)))
 cham, normal = chamfer_l1(samples, normals, pts, nrm)
 sdf_term = torch.nn.functional.l1_loss(sdf, approx_sdf(v, pts, nrm).float())
-total = 500 * cham + 0.001 * normal + 50 * sdf_term
+terms = {"chamfer": 500 * cham, "normal": 0.001 * normal, "sdf": 50 * sdf_term}
+for name, term in terms.items():  # each term's gradient alone: a small term's error would hide in the sum's
+    grads = torch.autograd.grad(term, [m.weight for m in linears], retain_graph=True)
+    mine, at = load(f"grad_{name}.bin", (P,)), 0
+    for i, gr in enumerate(grads):
+        close(f"{name} gradient, layer {i + 1}", mine[at:at + gr.numel()], gr.reshape(-1), 1e-3)
+        at += gr.numel()
+total = sum(terms.values())
 total.backward()
 for name, value in (("chamfer", cham), ("normal", normal), ("sdf", sdf_term), ("total", total)):
     close(name, meta[name], value.item())

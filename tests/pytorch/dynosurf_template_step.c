@@ -9,6 +9,7 @@
  *   grid_x.bin [nv][3]  grid_t.bin [nt][4] (int32)  pts.bin, nrm.bin [n][3]
  *   target.bin [nv]  params.bin [P]  pre_grad.bin [P]
  *   draw_face.bin [m] (int32)  draw_w.bin [m][3]  grad.bin [P]  after.bin [P]
+ *   grad_TERM.bin [P], TERM in chamfer normal sdf: each term alone
  *   meta.json {nv, nt, n, m, P, edge, pre_loss, chamfer, normal, sdf, total,
  *              n_verts, n_faces}
  * usage: dynosurf_template_step N M PRE SEED DIR */
@@ -89,6 +90,18 @@ int main(int argc, char **argv)
     int rc = export_f32(dir, "params.bin", params, P) | export_f32(dir, "pre_grad.bin", pre_grad, P);
 
     dyno_template_terms t;
+    const dyno_template_weights full = DYNO_TEMPLATE_WEIGHTS,
+                                alone[3] = {{full.chamfer, 0, 0}, {0, full.normal, 0}, {0, 0, full.sdf}};
+    static const char *names[3] = {"grad_chamfer.bin", "grad_normal.bin", "grad_sdf.bin"};
+    for (int term = 0; term < 3; term++) { /* each term alone, on the same draws */
+        tcb_rng again = rng;
+        fit.weights = alone[term];
+        memset(grad, 0, P * sizeof *grad);
+        if (dyno_template_loss(&fit, &s, &g, &again, &t, &err)) return fail(&err);
+        rc |= export_f32(dir, names[term], grad, P);
+    }
+    fit.weights = full;
+    memset(grad, 0, P * sizeof *grad);
     if (dyno_template_loss(&fit, &s, &g, &rng, &t, &err)) return fail(&err);
     int32_t *face = malloc((size_t)m * sizeof *face);
     float *w = malloc((size_t)m * 3 * sizeof *w);
