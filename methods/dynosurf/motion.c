@@ -44,7 +44,6 @@ int dyno_motion_fit_init(dyno_motion_fit *f, const dyno_motion_data *data, tcb_e
         return rc;
     }
     for (int t = 0; t < d->n_frames; t++) f->frames[t] = t;
-    for (int i = 0; i < d->n_grid; i++) f->perm[i] = i;
     return TCB_OK;
 }
 
@@ -58,10 +57,12 @@ void dyno_motion_fit_free(dyno_motion_fit *f)
 }
 
 /* g grid vertices without replacement (a partial Fisher–Yates shuffle of
- * f->perm), their positions and SDF values. */
+ * the identity, so that the picks depend on the stream alone and a resumed
+ * run draws what the unbroken one drew), their positions and SDF values. */
 static void pick_grid(dyno_motion_fit *f, struct tcb_rng *rng)
 {
     const dyno_motion_data *d = &f->data;
+    for (int i = 0; i < d->n_grid; i++) f->perm[i] = i;
     for (int i = 0; i < d->n_grid_samples; i++) {
         int j = i + (int)tcb_rng_below(rng, (uint32_t)(d->n_grid - i));
         int32_t keep = f->perm[i];

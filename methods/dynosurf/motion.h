@@ -65,7 +65,7 @@ typedef struct dyno_motion_data {
 typedef struct dyno_motion_fit {
     dyno_motion_data data;
     int *frames;             /* 0 … F − 1 */
-    int32_t *perm;           /* [n_grid]: the picks are its first n_grid_samples */
+    int32_t *perm;           /* [n_grid]: this step's picks are its first n_grid_samples */
     dyno_blend bt, bg;       /* blend weights of the template and of the picks */
     dyno_transforms tr;
     float *X, *dX;           /* [F][n_template][3] */

@@ -95,14 +95,12 @@ int main(int argc, char **argv)
     for (int term = 0; term < 5; term++) {
         tcb_rng again = rng;
         fit.data.weights = alone[term];
-        for (int i = 0; i < NG; i++) fit.perm[i] = i; /* the same picks each time */
         memset(grad, 0, P * sizeof *grad);
         if (dyno_motion_loss(&fit, &d, &g, &again, &t, &err)) return fail(&err);
         rc |= export_f32(dir, names[term], grad, P);
     }
     fit.data.weights = full;
     memset(grad, 0, P * sizeof *grad);
-    for (int i = 0; i < NG; i++) fit.perm[i] = i; /* the same picks again */
     if (dyno_motion_loss(&fit, &d, &g, &rng, &t, &err)) return fail(&err);
     int32_t *face = malloc(F * MS * sizeof *face);
     float *w = malloc(F * MS * 3 * sizeof *w);

@@ -1,0 +1,175 @@
+/* methods/dynosurf/train.c on three frames of a turning ellipsoid and a
+ * coarse grid: the phases follow one another (their boundaries, the
+ * optimiser's parameters: the pretraining moves the shape network alone,
+ * the blend pretraining MLP_W alone, stage 2 the deformer alone), the
+ * pretraining losses fall, the fitted frames are finite and share the
+ * template's vertices; a run resumed from a checkpoint in stage 2 (the
+ * template extracted again from the loaded weights) ends bit for bit where
+ * the unbroken run ends; a checkpoint of another schedule is refused. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "methods/dynosurf/grid.h"
+#include "methods/dynosurf/train.h"
+#include "tcb/meshing.h"
+#include "tcb/rng.h"
+
+enum { T = 3, N = 600 };
+
+typedef struct fixture {
+    float pts[T][3 * N], nrm[T][3 * N];
+    const float *pp[T], *np[T];
+    int n[T];
+    tcb_nn *index[T];
+    tcb_mesh hull, grown, shell;
+    tcb_tetmesh grid;
+    float *sd;
+    dyno_problem p;
+} fixture;
+
+static fixture *fx;
+
+static int setup(void **state)
+{
+    (void)state;
+    fx = calloc(1, sizeof *fx);
+    tcb_rng rng;
+    tcb_rng_seed(&rng, 4);
+    const double ax[3] = {0.3, 0.2, 0.15};
+    for (int t = 0; t < T; t++) {
+        double a = 0.2 * t, c = cos(a), s = sin(a);
+        for (int i = 0; i < N; i++) {
+            double u[3] = {tcb_rng_normal(&rng), tcb_rng_normal(&rng), tcb_rng_normal(&rng)};
+            double len = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]), q[3], g[3], gl = 0;
+            for (int k = 0; k < 3; k++) q[k] = ax[k] * u[k] / len, g[k] = u[k] / len / ax[k], gl += g[k] * g[k];
+            gl = sqrt(gl);
+            float *p = fx->pts[t] + 3 * i, *nn = fx->nrm[t] + 3 * i;
+            p[0] = (float)(c * q[0] - s * q[1]), p[1] = (float)(s * q[0] + c * q[1]), p[2] = (float)q[2];
+            nn[0] = (float)((c * g[0] - s * g[1]) / gl), nn[1] = (float)((s * g[0] + c * g[1]) / gl);
+            nn[2] = (float)(g[2] / gl);
+        }
+        fx->pp[t] = fx->pts[t], fx->np[t] = fx->nrm[t], fx->n[t] = N;
+    }
+    tcb_error err = {0};
+    for (int t = 0; t < T; t++)
+        if (tcb_nn_build(fx->pts[t], N, &fx->index[t], &err)) return 1;
+    /* a coarse grid: the grown hull remeshed to edges of 0.04 */
+    if (tcb_convex_hull(fx->pts[1], N, &fx->hull, &err) ||
+        tcb_convex_offset(fx->pts[1], N, DYNO_SHELL_OFFSET, &fx->grown, &err) ||
+        tcb_mesh_remesh(&fx->grown, 0.04, DYNO_REMESH_ITERATIONS, &fx->shell, &err) ||
+        tcb_tetrahedralize(&fx->shell, 2e-4, DYNO_TET_RADIUS_EDGE, &fx->grid, &err))
+        return 1;
+    fx->sd = malloc((size_t)fx->grid.n_verts * sizeof *fx->sd);
+    if (tcb_convex_signed_distance(&fx->hull, fx->grid.verts, fx->grid.n_verts, fx->sd, &err)) return 1;
+    fx->p = (dyno_problem){.T = T, .key = 1, .pts = fx->pp, .normals = fx->np, .n_pts = fx->n,
+                           .index = (const tcb_nn *const *)fx->index, .grid = &fx->grid,
+                           .edge = (float)dyno_tet_edge_bound(&fx->grid), .hull_sd = fx->sd};
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    for (int t = 0; t < T; t++) tcb_nn_free(fx->index[t]);
+    tcb_mesh_free(&fx->hull), tcb_mesh_free(&fx->grown), tcb_mesh_free(&fx->shell), tcb_tetmesh_free(&fx->grid);
+    free(fx->sd), free(fx);
+    return 0;
+}
+
+static dyno_schedule schedule(void)
+{
+    return (dyno_schedule){{200, 30, 30, 12}, 400, 300, 64, 1e-3, 0};
+}
+
+/* Which parameter blocks moved over a step: shape, control + MLP_T, MLP_W. */
+static void moved(const dyno_trainer *t, const float *before, int out[3])
+{
+    size_t blend = t->n_shape + dyno_deformer_blend_offset();
+    const size_t b[4] = {0, t->n_shape, blend, t->n_params};
+    for (int k = 0; k < 3; k++) out[k] = memcmp(before + b[k], t->params + b[k], (b[k + 1] - b[k]) * sizeof(float)) != 0;
+}
+
+static void test_phases(void **state)
+{
+    (void)state;
+    dyno_schedule s = schedule();
+    dyno_trainer t;
+    tcb_error err = {0};
+    assert_int_equal(dyno_trainer_init(&t, &fx->p, &s, 7, &err), TCB_OK);
+    long long total = dyno_total_steps(&s), start;
+    float *before = malloc(t.n_params * sizeof *before);
+    double first[DYNO_PHASES] = {0}, loss;
+    static const int expect[DYNO_PHASES][3] = {{1, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 1}};
+    for (long long it = 0; it < total; it++) {
+        int phase = dyno_phase_of(&s, it, &start);
+        memcpy(before, t.params, t.n_params * sizeof *before);
+        assert_int_equal(dyno_train_step(&t, &loss, &err), TCB_OK);
+        if (it == start) first[phase] = loss;
+        int m[3];
+        moved(&t, before, m);
+        for (int k = 0; k < 3; k++) assert_int_equal(m[k], expect[phase][k]);
+    }
+    assert_true(t.last[DYNO_PHASE_PRETRAIN] < 0.5 * first[DYNO_PHASE_PRETRAIN]);
+    assert_true(t.last[DYNO_PHASE_BLEND] < first[DYNO_PHASE_BLEND]);
+    const tcb_mt_surface *templ;
+    assert_int_equal(dyno_trainer_template(&t, &templ, &err), TCB_OK);
+    assert_true(templ->n_faces > 100);
+    float *X = malloc((size_t)T * templ->n_verts * 3 * sizeof *X);
+    assert_int_equal(dyno_trainer_frames(&t, X, &err), TCB_OK);
+    for (size_t i = 0; i < (size_t)T * templ->n_verts * 3; i++) assert_true(isfinite(X[i]));
+    free(X), free(before);
+    dyno_trainer_free(&t);
+}
+
+static void test_resume(void **state)
+{
+    (void)state;
+    dyno_schedule s = schedule();
+    long long total = dyno_total_steps(&s), cut = total - 5;
+    char path[] = "/tmp/tcb_dyno_ckptXXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    dyno_trainer a, b;
+    tcb_error err = {0};
+    double loss, seconds;
+    assert_int_equal(dyno_trainer_init(&a, &fx->p, &s, 9, &err), TCB_OK);
+    for (long long it = 0; it < total; it++) {
+        assert_int_equal(dyno_train_step(&a, &loss, &err), TCB_OK);
+        if (a.it == cut) assert_int_equal(dyno_train_save(&a, 9, 1.0, path, &err), TCB_OK);
+    }
+    assert_int_equal(dyno_trainer_init(&b, &fx->p, &s, 9, &err), TCB_OK);
+    assert_int_equal(dyno_train_step(&b, &loss, &err), TCB_OK); /* a state to be overwritten */
+    assert_int_equal(dyno_train_load(&b, 9, path, &seconds, &err), TCB_OK);
+    assert_int_equal(b.it, cut);
+    while (b.it < total) assert_int_equal(dyno_train_step(&b, &loss, &err), TCB_OK);
+    assert_memory_equal(a.params, b.params, a.n_params * sizeof(float));
+    dyno_trainer_free(&b);
+    /* another schedule's checkpoint */
+    dyno_schedule other = s;
+    other.steps[DYNO_PHASE_MOTION]++;
+    assert_int_equal(dyno_trainer_init(&b, &fx->p, &other, 9, &err), TCB_OK);
+    assert_int_equal(dyno_train_load(&b, 9, path, &seconds, &err), TCB_ERR_INPUT);
+    assert_non_null(strstr(err.msg, "motion steps"));
+    dyno_trainer_free(&b);
+    dyno_trainer_free(&a);
+    unlink(path);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_phases),
+        cmocka_unit_test(test_resume),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
