@@ -13,6 +13,7 @@ extern const tcb_method_ops tcb_method_mca;
 extern const tcb_method_ops tcb_method_cc;
 extern const tcb_method_ops tcb_method_neupig;
 extern const tcb_method_ops tcb_method_pdg;
+extern const tcb_method_ops tcb_method_dynosurf;
 extern const tcb_method_ops tcb_method_external;
 
 #endif

@@ -27,6 +27,7 @@ static const tcb_method_ops *const builtins[] = {
     &tcb_method_cc,
     &tcb_method_neupig,
     &tcb_method_pdg,
+    &tcb_method_dynosurf,
     &tcb_method_external,
 };
 #define N_BUILTINS ((int)(sizeof builtins / sizeof builtins[0]))

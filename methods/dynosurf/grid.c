@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "methods/pcgrid/prepare.h"
 #include "tcb/geometry.h"
 #include "tcb/meshing.h"
 #include "tcb/nn.h"
@@ -22,6 +23,16 @@ int dyno_frame_of(const float *pts0, int n, dyno_frame *f, tcb_error *err)
         for (int i = 0; i < n; i++) s += pts0[3 * (size_t)i + k];
         f->mean[k] = s / n;
     }
+    return TCB_OK;
+}
+
+int dyno_frame_map(const float *const *clouds, const int *n, int T, struct tcb_pcgrid_frame_map *map, tcb_error *err)
+{
+    dyno_frame f;
+    int rc = T > 0 ? dyno_frame_of(clouds[0], n[0], &f, err) : tcb_fail(err, TCB_ERR_INPUT, "dynosurf: no frame");
+    if (rc) return rc;
+    for (int k = 0; k < 3; k++) map->centre[k] = f.mean[k];
+    map->scale = 1.0 / f.diag;
     return TCB_OK;
 }
 
@@ -67,7 +78,7 @@ int dyno_keyframe(const float *const *points, const int *n, int T, int *key, tcb
     return rc;
 }
 
-int dyno_grid_build(const float *pts, int n, double max_volume, tcb_mesh *hull, tcb_mesh *shell,
+int dyno_grid_build(const float *pts, int n, double max_volume, double remesh, tcb_mesh *hull, tcb_mesh *shell,
                     tcb_tetmesh *grid, tcb_error *err)
 {
     tcb_mesh grown = {0};
@@ -77,7 +88,7 @@ int dyno_grid_build(const float *pts, int n, double max_volume, tcb_mesh *hull, 
     if (!rc) {
         double box[6];
         tcb_bbox(grown.verts, (size_t)grown.n_verts, box);
-        rc = tcb_mesh_remesh(&grown, DYNO_REMESH_FRACTION * tcb_bbox_diag(box), DYNO_REMESH_ITERATIONS, shell, err);
+        rc = tcb_mesh_remesh(&grown, remesh * tcb_bbox_diag(box), DYNO_REMESH_ITERATIONS, shell, err);
     }
     if (!rc) rc = tcb_tetrahedralize(shell, max_volume, DYNO_TET_RADIUS_EDGE, grid, err);
     tcb_mesh_free(&grown);

@@ -40,6 +40,11 @@ typedef struct dyno_frame {
  * or all the same. */
 int dyno_frame_of(const float *pts0, int n, dyno_frame *f, tcb_error *err);
 
+/* The frame of the first of T clouds as the pcgrid read-out's map
+ * (methods/pcgrid/fitted.h: centre the mean, scale 1/diag). */
+struct tcb_pcgrid_frame_map;
+int dyno_frame_map(const float *const *clouds, const int *n, int T, struct tcb_pcgrid_frame_map *map, tcb_error *err);
+
 /* out [n][3] = the frame applied to pts [n][3] (may alias). */
 void dyno_map_points(const dyno_frame *f, const float *pts, int n, float *out);
 
@@ -48,9 +53,10 @@ int dyno_keyframe(const float *const *points, const int *n, int T, int *key, tcb
 
 /* The grid around the keyframe's normalised points [n][3], with the hull
  * (DynoSurf's SDF pretraining target) and the shell that was filled;
- * max_volume is DYNO_TET_VOLUME at the reference's resolution (the `cpu`
- * and `tiny` presets coarsen it). */
-int dyno_grid_build(const float *pts, int n, double max_volume, tcb_mesh *hull, tcb_mesh *shell,
+ * max_volume is DYNO_TET_VOLUME and remesh DYNO_REMESH_FRACTION (of the
+ * shell's box diagonal) at the reference's resolution (the `cpu` and
+ * `tiny` presets coarsen them). */
+int dyno_grid_build(const float *pts, int n, double max_volume, double remesh, tcb_mesh *hull, tcb_mesh *shell,
                     tcb_tetmesh *grid, tcb_error *err);
 
 /* calc_tet_edge_length: the shortest of every tet's six edges, or the

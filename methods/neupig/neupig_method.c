@@ -121,9 +121,9 @@ typedef struct problem {
     tcb_neupig_problem p;
 } problem;
 
-static int problem_init(void *self, tcb_pcgrid_inputs *in, tcb_error *err)
+static int problem_init(void *self, const tcb_sequence *seq, tcb_pcgrid_inputs *in, tcb_error *err)
 {
-    (void)self;
+    (void)self, (void)seq;
     problem *pb = in->problem;
     const tcb_mesh *t = in->template_mesh;
     int ne = 0;

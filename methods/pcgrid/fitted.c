@@ -8,7 +8,8 @@
 #include "tcb/locate.h"
 
 int tcb_pcgrid_clouds_draw(const tcb_sequence *seq, int points, uint64_t seed, const char *stream,
-                           tcb_pcgrid_frame_map *map, tcb_pcgrid_clouds *out, tcb_error *err)
+                           tcb_pcgrid_map_fn map_of, tcb_pcgrid_frame_map *map, tcb_pcgrid_clouds *out,
+                           tcb_error *err)
 {
     memset(out, 0, sizeof *out);
     out->T = seq->n_frames;
@@ -25,7 +26,7 @@ int tcb_pcgrid_clouds_draw(const tcb_sequence *seq, int points, uint64_t seed, c
             return tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
         rc = tcb_sequence_draw_points(seq, t, points, seq->draw_with_replacement, &rng, out->clouds[t], err);
     }
-    if (!rc) rc = tcb_pcgrid_frame_map_of((const float *const *)out->clouds, out->n, out->T, map, err);
+    if (!rc) rc = (map_of ? map_of : tcb_pcgrid_frame_map_of)((const float *const *)out->clouds, out->n, out->T, map, err);
     for (int t = 0; !rc && t < out->T; t++) {
         tcb_pcgrid_map_points(map, out->clouds[t], out->n[t], out->clouds[t]);
         rc = tcb_nn_build(out->clouds[t], out->n[t], &out->index[t], err);

@@ -27,11 +27,18 @@ typedef struct tcb_pcgrid_clouds {
     tcb_nn **index;   /* [T] */
 } tcb_pcgrid_clouds;
 
+/* The map of the drawn clouds into a method's frame (tcb_pcgrid_frame_map_of:
+ * the pcgrid cube). */
+typedef int (*tcb_pcgrid_map_fn)(const float *const *clouds, const int *n, int T, tcb_pcgrid_frame_map *map,
+                                 tcb_error *err);
+
 /* `points` points a frame drawn from seq's pools (as the sequence draws:
  * with or without replacement) from the stream (seed, stream), the map of
- * all of them into the cube (*map), and the mapped clouds indexed. */
+ * all of them (map_of; NULL: into the cube) in *map, and the mapped clouds
+ * indexed. */
 int tcb_pcgrid_clouds_draw(const tcb_sequence *seq, int points, uint64_t seed, const char *stream,
-                           tcb_pcgrid_frame_map *map, tcb_pcgrid_clouds *out, tcb_error *err);
+                           tcb_pcgrid_map_fn map_of, tcb_pcgrid_frame_map *map, tcb_pcgrid_clouds *out,
+                           tcb_error *err);
 void tcb_pcgrid_clouds_free(tcb_pcgrid_clouds *c);
 
 /* A fitted model: the template and its vertices in every frame. */

@@ -62,15 +62,20 @@ static int prepare(tcb_pcgrid_method *b, const tcb_sequence *seq, uint64_t seed,
     b->spec.seed = seed;
     char stream[64];
     snprintf(stream, sizeof stream, "%s/points", h->name);
-    int rc = tcb_pcgrid_clouds_draw(seq, b->points, seed, stream, &f->map, &in->clouds, err);
+    int rc = tcb_pcgrid_clouds_draw(seq, b->points, seed, stream, h->frame_map, &f->map, &in->clouds, err);
     tcb_pcgrid_clouds *c = &in->clouds;
-    if (!rc) rc = tcb_pcgrid_keyframe((const float *const *)c->clouds, c->n, c->T, b->keyframe_res, &in->key, err);
+    const float *const *clouds = (const float *const *)c->clouds;
+    in->map = &f->map;
     if (!rc)
+        rc = h->keyframe ? h->keyframe(clouds, c->n, c->T, &in->key, err)
+                         : tcb_pcgrid_keyframe(clouds, c->n, c->T, b->keyframe_res, &in->key, err);
+    if (!rc && !h->trained_template) {
         rc = tcb_pcgrid_template_build(seq, in->key, &f->map, c->clouds[in->key], c->n[in->key], &b->spec,
                                        &f->template_mesh, err);
-    in->template_mesh = &f->template_mesh;
+        in->template_mesh = &f->template_mesh;
+    }
     if (!rc && !(in->problem = calloc(1, h->problem_size))) rc = tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
-    if (!rc) rc = h->problem_init(b, in, err);
+    if (!rc) rc = h->problem_init(b, seq, in, err);
     if (rc) {
         inputs_free(b, in);
         tcb_error_prefix(err, "%s: ", h->name);
@@ -128,9 +133,15 @@ static int loop_load(void *t, const char *path, double *seconds, tcb_error *err)
 }
 
 /* The fitted model of t's parameters: a copy of them (for save) and the
- * template carried into every one of the inputs' frames. */
+ * template (the trainer's own, for a method that makes it) carried into
+ * every one of the inputs' frames. */
 static int keep_model(tcb_pcgrid_method *b, const tcb_pcgrid_inputs *in, const trainer *t, tcb_error *err)
 {
+    if (b->hooks->trained_template) {
+        tcb_mesh_free(&b->fitted.template_mesh);
+        int rc = b->hooks->trained_template(t->state, &b->fitted.template_mesh, err);
+        if (rc) return rc;
+    }
     size_t n = 0;
     const float *params = b->hooks->params(t->state, &n);
     free(b->params), free(b->fitted.deformed);
@@ -185,8 +196,10 @@ int tcb_pcgrid_fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, 
     b->seed = ctx->seed;
     tcb_pcgrid_inputs in;
     trainer t = {0};
+    int made_later = b->hooks->trained_template != NULL;
     int rc = prepare(b, seq, ctx->seed, &b->fitted, &in, err);
-    if (!rc) rc = tcb_pcgrid_template_write(&b->fitted.template_mesh, &b->fitted.map, ctx->work_dir, in.key, err);
+    if (!rc && !made_later)
+        rc = tcb_pcgrid_template_write(&b->fitted.template_mesh, &b->fitted.map, ctx->work_dir, in.key, err);
     if (!rc) rc = trainer_init(b, &in, ctx->seed, &t, err);
     if (!rc) {
         tcb_train_loop loop = {.name = b->hooks->name, .iterations = b->epochs,
@@ -195,6 +208,8 @@ int tcb_pcgrid_fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, 
         rc = tcb_train_loop_run(&loop, ctx, err);
     }
     if (!rc) rc = keep_model(b, &in, &t, err);
+    if (!rc && made_later)
+        rc = tcb_pcgrid_template_write(&b->fitted.template_mesh, &b->fitted.map, ctx->work_dir, in.key, err);
     trainer_free(&t);
     inputs_free(b, &in);
     return rc;

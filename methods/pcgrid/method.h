@@ -28,9 +28,12 @@
 #include "tcb/method.h"
 
 /* What the method's problem is built from: every frame's cloud in the
- * cube, the keyframe and the template as it starts. */
+ * method's frame (the cube, or the method's map), the map, the keyframe
+ * and the template as it starts (NULL for a method whose trainer makes
+ * its template: hooks->trained_template). */
 typedef struct tcb_pcgrid_inputs {
     tcb_pcgrid_clouds clouds;
+    const tcb_pcgrid_frame_map *map;
     int key;
     const tcb_mesh *template_mesh;
     void *problem;               /* hooks->problem_size bytes, the method's */
@@ -42,9 +45,10 @@ typedef struct tcb_pcgrid_hooks {
     const char *name;            /* messages, the bar, the stream "<name>/points" */
     const char *magic;           /* the model file's 8 bytes */
     size_t problem_size, trainer_size;
-    /* The method's problem over in (in->problem, zeroed); problem_free
-     * releases what it allocated, also after a failed init. */
-    int (*problem_init)(void *self, tcb_pcgrid_inputs *in, tcb_error *err);
+    /* The method's problem over in (in->problem, zeroed), from seq too (its
+     * normals, say); problem_free releases what it allocated, also after a
+     * failed init. */
+    int (*problem_init)(void *self, const tcb_sequence *seq, tcb_pcgrid_inputs *in, tcb_error *err);
     void (*problem_free)(void *problem);
     int (*trainer_init)(void *trainer, const void *self, const void *problem, uint64_t seed, tcb_error *err);
     void (*trainer_free)(void *trainer);
@@ -64,6 +68,18 @@ typedef struct tcb_pcgrid_hooks {
      * phase that dominates a fit (tcb/method.h, train_steps): PDG's first
      * 101 epochs train the input term alone, cheaper than the rest. */
     void (*main_phase)(void *trainer);
+    /* Optional (NULL: the pcgrid cube, prepare.h). The map of the drawn
+     * clouds into the method's frame. */
+    tcb_pcgrid_map_fn frame_map;
+    /* Optional (NULL: the occupancy rule, prepare.h). The keyframe of the
+     * mapped clouds. */
+    int (*keyframe)(const float *const *clouds, const int *n, int T, int *key, tcb_error *err);
+    /* Optional (NULL: the keyframe's Poisson template, built before the
+     * first step from b->spec). A method whose trainer makes its template
+     * (DynoSurf extracts it after its stage 1): no template is built, and
+     * after training this copies the trainer's into *out, the mesh the
+     * read-out carries. */
+    int (*trained_template)(void *trainer, tcb_mesh *out, tcb_error *err);
 } tcb_pcgrid_hooks;
 
 enum { TCB_PCGRID_NORMALS_ESTIMATED, TCB_PCGRID_NORMALS_GT, TCB_PCGRID_NORMALS_INPUT };

@@ -27,11 +27,8 @@ static void unit_face_normal(const float *a, const float *b, const float *c, flo
     for (int k = 0; k < 3; k++) out[k] = (float)(len > 0 ? nn[k] / len : 0.0);
 }
 
-/* The GT face under each point of the keyframe's cloud (the cloud comes
- * from the GT surface; the map is a similarity, so face normals are the
- * same in the cube). */
-static int gt_normals(const tcb_sequence *seq, int key, const tcb_pcgrid_frame_map *map, const float *cloud,
-                      int n, float *normals, tcb_error *err)
+int tcb_pcgrid_gt_normals(const tcb_sequence *seq, int key, const tcb_pcgrid_frame_map *map, const float *cloud,
+                          int n, float *normals, tcb_error *err)
 {
     if (!seq->n_faces)
         return tcb_fail(err, TCB_ERR_INPUT, "GT normals need the GT surface, and sequence %s is points alone "
@@ -118,7 +115,7 @@ int tcb_pcgrid_template_build(const tcb_sequence *seq, int key, const tcb_pcgrid
     float *normals = malloc((size_t)n * 3 * sizeof *normals);
     tcb_mesh surface = {0, 0, NULL, NULL};
     int rc = !normals              ? tcb_fail(err, TCB_ERR_NOMEM, "template: out of memory")
-             : spec->gt_normals ? gt_normals(seq, key, map, cloud, n, normals, err)
+             : spec->gt_normals ? tcb_pcgrid_gt_normals(seq, key, map, cloud, n, normals, err)
                                 : tcb_estimate_normals(cloud, n, TCB_NORMALS_K, normals, err);
     if (!rc) rc = tcb_poisson_reconstruct(cloud, normals, n, spec->poisson_depth, &surface, err);
     if (!rc)

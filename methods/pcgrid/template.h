@@ -47,6 +47,13 @@ int tcb_pcgrid_template_build(const tcb_sequence *seq, int key, const tcb_pcgrid
 
 /* The template's area-weighted vertex normals into *normals, malloc'ed
  * [t->n_verts][3] and the caller's to free; NULL on failure. */
+/* Frame `frame`'s GT face normal under each of n points of its cloud
+ * (in the map's frame; the cloud comes from the GT surface and the map is
+ * a similarity, so face normals are the same there): normals [n][3]. An
+ * error for a sequence of points alone, which has no GT surface. */
+int tcb_pcgrid_gt_normals(const tcb_sequence *seq, int frame, const tcb_pcgrid_frame_map *map, const float *cloud,
+                          int n, float *normals, tcb_error *err);
+
 int tcb_pcgrid_template_normals(const tcb_mesh *t, float **normals, tcb_error *err);
 
 /* The template's undirected edges, each once with a < b in vertex order,

@@ -125,9 +125,9 @@ static int create(const char *params_json, void **self, tcb_error *err)
 
 /* ---- the trainer's hooks (methods/pcgrid/method.h) ---- */
 
-static int problem_init(void *self, tcb_pcgrid_inputs *in, tcb_error *err)
+static int problem_init(void *self, const tcb_sequence *seq, tcb_pcgrid_inputs *in, tcb_error *err)
 {
-    (void)self;
+    (void)self, (void)seq;
     const tcb_pcgrid_clouds *c = &in->clouds;
     if (c->T < 2) return tcb_fail(err, TCB_ERR_INPUT, "a sequence of %d frame has no transition to fit", c->T);
     *(tcb_pdg_data *)in->problem = (tcb_pdg_data){c->T, in->key, (const float *const *)c->clouds, c->n,

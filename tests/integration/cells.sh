@@ -1,5 +1,5 @@
 # Sourced by the integration tests that interrupt runs and compare them cell
-# by cell.
+# by cell, and by those that check the cells of a carried template.
 
 # enter_temp_dir: a fresh temporary directory as $tmp and the working
 # directory, removed at exit, when a background run whose pid the test puts
@@ -87,4 +87,25 @@ kill_mid_fit() {
     # Not quiet (CI=true would be): the resume is announced at log level info.
     CI= "$TCBENCH" run "$config" --out killed "$@" 2> resume.log
     grep -q "resuming training at iteration [1-9]" resume.log || { echo "FAIL: did not resume"; cat resume.log; exit 1; }
+}
+
+# check_carried_cell CELL: the cell of a method whose template is carried
+# into every frame (pdg, dynosurf) is ok with every metric, a CD on each of
+# its 6 pairs, and the reconstruction metrics of its surface on every frame
+# of its pairs.
+check_carried_cell() {
+    /usr/bin/python3 - "$1" <<'PY'
+import json, math, sys
+c = json.load(open(sys.argv[1]))
+assert c["status"] == "ok", (c["status"], c["message"])
+s = c["summary"]
+assert s["n_pairs"] == 6 and s["cd"]["n"] == 6
+for key in ("sl2", "rank", "auc", "cd", "geo"):
+    assert math.isfinite(s[key]["mean"]), key
+frames = sorted({f for p in c["pairs"] for f in p[:2]})
+surf = c["surface"]
+assert [r[0] for r in surf["rows"]] == frames, surf
+for key in ("cdl2", "nc", "fscore05", "fscore1"):
+    assert s[key]["n"] == len(frames), (key, s[key])
+PY
 }

@@ -26,23 +26,7 @@ work=work/synth/quadruped_walk/pdg/seed_0
 
 "$TCBENCH" run pdg.json --out full --quiet
 ls full/$work/template_keyframe_*.obj > /dev/null || { echo "FAIL: no template written"; exit 1; }
-check_cell() {
-    /usr/bin/python3 - "$1" <<'PY'
-import json, math, sys
-c = json.load(open(sys.argv[1]))
-assert c["status"] == "ok", (c["status"], c["message"])
-s = c["summary"]
-assert s["n_pairs"] == 6 and s["cd"]["n"] == 6
-for key in ("sl2", "rank", "auc", "cd", "geo"):
-    assert math.isfinite(s[key]["mean"]), key
-frames = sorted({f for p in c["pairs"] for f in p[:2]})
-surf = c["surface"]
-assert [r[0] for r in surf["rows"]] == frames, surf
-for key in ("cdl2", "nc", "fscore05", "fscore1"):
-    assert s[key]["n"] == len(frames), (key, s[key])
-PY
-}
-check_cell full/$cell
+check_carried_cell full/$cell
 
 "$TCBENCH" inspect full pdg 0 --out insp > inspect.txt
 grep -q "agree: largest relative difference 0.0e+00" inspect.txt || { cat inspect.txt; exit 1; }
@@ -52,7 +36,7 @@ same_cells full killed
 
 sed 's/"checkpoint_every": 4/"checkpoint_every": 4, "rotation": "cayley"/' pdg.json > cayley.json
 "$TCBENCH" run cayley.json --out cayley --quiet
-check_cell cayley/$cell
+check_carried_cell cayley/$cell
 # the cayley model under the released cell's record (its params made the
 # released ones): the model file's manifest refuses it
 cp -r full swapped

@@ -63,7 +63,7 @@ int main(int argc, char **argv)
     ellipsoid(&rng, n, pts, nrm);
     tcb_mesh hull, shell;
     tcb_tetmesh grid;
-    if (dyno_grid_build(pts, n, 1e-4, &hull, &shell, &grid, &err)) return fail(&err);
+    if (dyno_grid_build(pts, n, 1e-4, DYNO_REMESH_FRACTION, &hull, &shell, &grid, &err)) return fail(&err);
     float *target = malloc((size_t)grid.n_verts * sizeof *target);
     if (tcb_convex_signed_distance(&hull, grid.verts, grid.n_verts, target, &err)) return fail(&err);
     float edge = (float)dyno_tet_edge_bound(&grid);

@@ -107,7 +107,7 @@ static void check_grid(const float *pts, int n, double max_volume, const char *w
     tcb_error err = {0};
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
-    int rc = dyno_grid_build(pts, n, max_volume, &hull, &shell, &grid, &err);
+    int rc = dyno_grid_build(pts, n, max_volume, DYNO_REMESH_FRACTION, &hull, &shell, &grid, &err);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     if (rc) fail_msg("%s", err.msg);
     double worst = 0, total = 0;
