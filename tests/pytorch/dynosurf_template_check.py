@@ -26,7 +26,7 @@ from dynosurf_torch import (approx_sdf, chamfer_l1, marching_tetrahedra,  # noqa
                             sample_points, shape_forward, shape_net)
 
 binary, work = sys.argv[1], sys.argv[2]
-N, M, PRE, SEED = 1000, 10000, 200, 3
+N, M, PRE, SEED = 1000, 10000, 100, 3
 subprocess.run([binary, str(N), str(M), str(PRE), str(SEED), work], check=True)
 meta = json.load(open(f"{work}/meta.json"))
 nv, nt, P = meta["nv"], meta["nt"], meta["P"]

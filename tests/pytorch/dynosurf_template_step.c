@@ -1,6 +1,7 @@
 /* Helper of dynosurf_template_check.py: DynoSurf's template objectives
  * (methods/dynosurf/template.c) on an ellipsoid's points and normals, on
- * the grid dyno_grid_build makes around them. The network is first brought
+ * the grid dyno_grid_build makes around them (its shell remeshed to 4 % of
+ * its diagonal: a test-sized grid). The network is first brought
  * near the hull's signed distance (PRE Adam steps of the pretraining at
  * lr 1e-3) so that its zero set crosses the grid; then, from those
  * weights, one pretraining loss and one stage-1 loss with its draws, and
@@ -63,7 +64,7 @@ int main(int argc, char **argv)
     ellipsoid(&rng, n, pts, nrm);
     tcb_mesh hull, shell;
     tcb_tetmesh grid;
-    if (dyno_grid_build(pts, n, 1e-4, DYNO_REMESH_FRACTION, &hull, &shell, &grid, &err)) return fail(&err);
+    if (dyno_grid_build(pts, n, 1e-4, 0.04, &hull, &shell, &grid, &err)) return fail(&err);
     float *target = malloc((size_t)grid.n_verts * sizeof *target);
     if (tcb_convex_signed_distance(&hull, grid.verts, grid.n_verts, target, &err)) return fail(&err);
     float edge = (float)dyno_tet_edge_bound(&grid);
