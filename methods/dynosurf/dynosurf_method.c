@@ -26,6 +26,7 @@
  * same seed, the same grid). Read-out, checkpoints and the model file are
  * the pcgrid methods' shared ops (methods/pcgrid/method.h) with the
  * trainer's own template. */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -158,6 +159,13 @@ static int problem_init(void *self, const tcb_sequence *seq, tcb_pcgrid_inputs *
     return rc;
 }
 
+static void describe(const void *problem_, char *line, size_t size)
+{
+    const problem *pb = problem_;
+    snprintf(line, size, "keyframe %d; grid %d vertices, %d tets, edge bound %.3g; hull %d faces", pb->p.key,
+             pb->grid.n_verts, pb->grid.n_tets, pb->p.edge, pb->hull.n_faces);
+}
+
 /* ---- the trainer's hooks (methods/pcgrid/method.h) ---- */
 
 static int trainer_init(void *t, const void *self, const void *pb, uint64_t seed, tcb_error *err)
@@ -226,6 +234,7 @@ static const tcb_pcgrid_hooks hooks = {
     .step = step, .done = done, .save = save, .load = load,
     .params = params, .frames = frames, .manifest = manifest,
     .frame_map = dyno_frame_map, .keyframe = dyno_keyframe, .trained_template = trained_template,
+    .describe = describe,
 };
 
 /* No estimate and no calibration yet: a step's cost differs by phase by

@@ -200,6 +200,11 @@ int tcb_pcgrid_fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, 
     int rc = prepare(b, seq, ctx->seed, &b->fitted, &in, err);
     if (!rc && !made_later)
         rc = tcb_pcgrid_template_write(&b->fitted.template_mesh, &b->fitted.map, ctx->work_dir, in.key, err);
+    if (!rc && b->hooks->describe) {
+        char line[256];
+        b->hooks->describe(in.problem, line, sizeof line);
+        tcb_report_log(&ctx->reporter, TCB_LOG_INFO, "%s: %s", b->hooks->name, line);
+    }
     if (!rc) rc = trainer_init(b, &in, ctx->seed, &t, err);
     if (!rc) {
         tcb_train_loop loop = {.name = b->hooks->name, .iterations = b->epochs,

@@ -80,6 +80,9 @@ typedef struct tcb_pcgrid_hooks {
      * after training this copies the trainer's into *out, the mesh the
      * read-out carries. */
     int (*trained_template)(void *trainer, tcb_mesh *out, tcb_error *err);
+    /* Optional (NULL: nothing). One line on the problem a fit is about to
+     * train (its sizes), which fit logs at info level. */
+    void (*describe)(const void *problem, char *line, size_t size);
 } tcb_pcgrid_hooks;
 
 enum { TCB_PCGRID_NORMALS_ESTIMATED, TCB_PCGRID_NORMALS_GT, TCB_PCGRID_NORMALS_INPUT };
