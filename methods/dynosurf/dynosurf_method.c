@@ -126,7 +126,7 @@ static int frame_normals(const tcb_pcgrid_method *b, const tcb_sequence *seq, co
                          problem *pb, tcb_error *err)
 {
     const tcb_pcgrid_clouds *c = &in->clouds;
-    int gt = !strcmp(tcb_pcgrid_normals_used((void *)b, seq), "gt");
+    int gt = tcb_pcgrid_uses_gt_normals(b, seq);
     pb->T = c->T;
     if (!(pb->normals = calloc((size_t)c->T, sizeof *pb->normals)))
         return tcb_fail(err, TCB_ERR_NOMEM, "out of memory");

@@ -231,10 +231,14 @@ int dyno_motion_loss(dyno_motion_fit *f, const dyno_deformer *dfm, const dyno_de
     return TCB_OK;
 }
 
-void dyno_motion_frame(dyno_motion_fit *f, const dyno_deformer *dfm, int t, float *X)
+void dyno_motion_frames(dyno_motion_fit *f, const dyno_deformer *dfm, float *X)
 {
     const dyno_motion_data *d = &f->data;
+    size_t m = (size_t)d->n_template;
+    /* The blend weights once for every frame: they do not depend on t. */
     dyno_blend_forward(dfm, &f->bt, d->template_verts, d->n_template);
-    dyno_transforms_forward(dfm, &f->tr, &f->frames[t], 1);
-    dyno_deform_apply(d->template_verts, d->n_template, f->bt.w, f->tr.R, f->tr.raw, X);
+    dyno_transforms_forward(dfm, &f->tr, f->frames, d->n_frames);
+    for (int t = 0; t < d->n_frames; t++)
+        dyno_deform_apply(d->template_verts, d->n_template, f->bt.w, f->tr.R + 9 * K * t, f->tr.raw + 6 * K * t,
+                          X + 3 * m * t);
 }

@@ -90,7 +90,7 @@ typedef struct dyno_motion_terms {
 int dyno_motion_loss(dyno_motion_fit *f, const dyno_deformer *d, const dyno_deformer *grad, struct tcb_rng *rng,
                      dyno_motion_terms *t, tcb_error *err);
 
-/* The template's vertices carried to frame t: X [n_template][3]. */
-void dyno_motion_frame(dyno_motion_fit *f, const dyno_deformer *d, int t, float *X);
+/* The template's vertices carried to every frame: X [F][n_template][3]. */
+void dyno_motion_frames(dyno_motion_fit *f, const dyno_deformer *d, float *X);
 
 #endif

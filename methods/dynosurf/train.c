@@ -175,8 +175,7 @@ int dyno_trainer_template(dyno_trainer *t, const tcb_mt_surface **out, tcb_error
 int dyno_trainer_frames(dyno_trainer *t, float *X, tcb_error *err)
 {
     int rc = prepare_motion(t, err);
-    size_t m = (size_t)t->templ.n_verts;
-    for (int u = 0; !rc && u < t->p->T; u++) dyno_motion_frame(&t->mfit, &t->def, u, X + 3 * m * u);
+    if (!rc) dyno_motion_frames(&t->mfit, &t->def, X);
     return rc;
 }
 

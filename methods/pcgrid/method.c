@@ -26,9 +26,7 @@ int tcb_pcgrid_parse_common(const cJSON *j, const char *where, tcb_pcgrid_method
     return rc;
 }
 
-/* Whether the keyframe's normals are GT's on seq: the "normals" param, or
- * under "input" the sequence's input normals. */
-static int uses_gt_normals(const tcb_pcgrid_method *b, const tcb_sequence *seq)
+int tcb_pcgrid_uses_gt_normals(const tcb_pcgrid_method *b, const tcb_sequence *seq)
 {
     return b->normals == TCB_PCGRID_NORMALS_GT ||
            (b->normals == TCB_PCGRID_NORMALS_INPUT && seq->input_normals == TCB_INPUT_NORMALS_GT);
@@ -36,7 +34,7 @@ static int uses_gt_normals(const tcb_pcgrid_method *b, const tcb_sequence *seq)
 
 const char *tcb_pcgrid_normals_used(void *self, const tcb_sequence *seq)
 {
-    return uses_gt_normals(self, seq) ? "gt" : "estimated";
+    return tcb_pcgrid_uses_gt_normals(self, seq) ? "gt" : "estimated";
 }
 
 /* ---- the inputs of an optimisation, rebuilt identically by fit and load ---- */
@@ -58,7 +56,7 @@ static int prepare(tcb_pcgrid_method *b, const tcb_sequence *seq, uint64_t seed,
     const tcb_pcgrid_hooks *h = b->hooks;
     memset(in, 0, sizeof *in);
     tcb_mesh_free(&f->template_mesh);
-    b->spec.gt_normals = uses_gt_normals(b, seq);
+    b->spec.gt_normals = tcb_pcgrid_uses_gt_normals(b, seq);
     b->spec.seed = seed;
     char stream[64];
     snprintf(stream, sizeof stream, "%s/points", h->name);

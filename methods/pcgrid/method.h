@@ -132,6 +132,9 @@ int tcb_pcgrid_train_steps(void *self, const tcb_sequence *seq, const tcb_fit_ct
 const tcb_pcgrid_inputs *tcb_pcgrid_steps_inputs(const void *self, const void **trainer);
 int tcb_pcgrid_run_unit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, int unit, tcb_error *err);
 const char *tcb_pcgrid_normals_used(void *self, const tcb_sequence *seq);
+/* Whether b's normals on seq are GT's: its "normals" param, or under
+ * "input" the sequence's input normals. */
+int tcb_pcgrid_uses_gt_normals(const tcb_pcgrid_method *b, const tcb_sequence *seq);
 extern const char *const tcb_pcgrid_units[]; /* {"template", NULL} */
 
 /* Those entries, for a method's ops table. */
