@@ -47,8 +47,8 @@ typedef struct dyno_preset {
 
 static const dyno_preset presets[] = {
     {{1000, 5000, 4000, 10000}, 5000, 10000, 10000, DYNO_TET_VOLUME, DYNO_REMESH_FRACTION, 1e-4}, /* paper */
-    {{1000, 2000, 1000, 2000}, 2500, 5000, 3000, 4e-6, 0.02, 1e-4},                               /* cpu */
-    {{200, 30, 30, 15}, 300, 400, 300, 2e-4, 0.05, 1e-3},                                          /* tiny */
+    {{1000, 1500, 1000, 800}, 2500, 3000, 1500, 4e-6, 0.02, 1e-4},                                 /* cpu */
+    {{100, 30, 10, 15}, 300, 400, 300, 2e-4, 0.05, 1e-3},                                          /* tiny */
 };
 static const char *const preset_names[] = {"paper", "cpu", "tiny", NULL};
 

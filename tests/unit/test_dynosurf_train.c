@@ -87,7 +87,7 @@ static int teardown(void **state)
 
 static dyno_schedule schedule(void)
 {
-    return (dyno_schedule){{200, 30, 30, 12}, 400, 300, 64, 1e-3, 0};
+    return (dyno_schedule){{100, 30, 30, 12}, 400, 300, 64, 1e-3, 0};
 }
 
 /* Which parameter blocks moved over a step: shape, control + MLP_T, MLP_W. */
