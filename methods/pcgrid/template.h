@@ -4,7 +4,7 @@
  * the remeshed surface and the remeshing repeated until it passes (PDG
  * src/utilities/util.py) —, the vertex normals and edges that an
  * optimisation reads from it, and its OBJ for people to check
- * (scripts/neupig_template.py). Fit and load build it the same way from
+ * (scripts/keyframe_template.py). Fit and load build it the same way from
  * the same clouds, so it is rebuilt rather than stored.
  *
  * Everything here is in the grids' cube (methods/pcgrid/prepare.h) but the
@@ -62,7 +62,7 @@ int tcb_pcgrid_template_normals(const tcb_mesh *t, float **normals, tcb_error *e
 int tcb_pcgrid_template_edges(const tcb_mesh *t, int32_t **edges, float **edge_len, int *ne, tcb_error *err);
 
 /* The template as fitting starts, for people to open and check against
- * the keyframe's GT mesh (scripts/neupig_template.py): t (in the cube)
+ * the keyframe's GT mesh (scripts/keyframe_template.py): t (in the cube)
  * mapped back by map into the sequence's coordinates and written to
  * <work_dir>/template_keyframe_<keyframe>.obj; t is left as it is. */
 int tcb_pcgrid_template_write(const tcb_mesh *t, const tcb_pcgrid_frame_map *map, const char *work_dir,

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # neupig's fit writes its keyframe template (template_keyframe_<K>.obj, in
-# the sequence's coordinates) and scripts/neupig_template.py measures it
+# the sequence's coordinates) and scripts/keyframe_template.py measures it
 # against frame K's GT mesh: the counts are the OBJ's, the face budget
 # holds, the surface lies on the GT one (sqrt(CD)/diag small; GT normals,
 # as the reference: estimated ones fold the synthetic legs, docs/meshing.md),
@@ -26,7 +26,7 @@ work=run/work/synth/quadruped_walk/neupig/seed_0
 "$TCBENCH" run np.json --out run --quiet
 ls $work/template_keyframe_*.obj > /dev/null
 
-check() { py "$TCB_SOURCE_DIR/scripts/neupig_template.py" np.json synth/quadruped_walk "$1" --samples 20000; }
+check() { py "$TCB_SOURCE_DIR/scripts/keyframe_template.py" np.json synth/quadruped_walk "$1" --samples 20000; }
 check $work > good.txt
 cat good.txt
 py - good.txt $work <<'PY'

@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
-"""neupig's keyframe template against the keyframe's ground-truth mesh.
+"""A template method's keyframe template against the keyframe's ground-truth mesh.
 
-    scripts/neupig_template.py CONFIG DATASET/SEQUENCE WORK_DIR [--samples N] [--seed S]
+    scripts/keyframe_template.py CONFIG DATASET/SEQUENCE WORK_DIR [--samples N] [--seed S]
 
-WORK_DIR is a neupig cell's work directory (runs/<run>/work/<dataset>/
-<sequence>/<method>/seed_<s>), where its fit wrote template_keyframe_<K>.obj
-in the sequence's coordinates. Prints one line per measure: the template's
-vertex and face counts; its edges with one face (holes) and with more than
+WORK_DIR is a neupig, pdg or dynosurf cell's work directory (runs/<run>/
+work/<dataset>/<sequence>/<method>/seed_<s>), where its fit wrote
+template_keyframe_<K>.obj in the sequence's coordinates (neupig and pdg
+before training, dynosurf after its stage 1). Prints one line per measure:
+the template's vertex and face counts; its edges with one face (holes) and with more than
 two (sheets that touch); whether every directed edge occurs once
 (consistently oriented); its connected components and the largest one's
 faces; and sqrt(Chamfer)/diagonal against frame K of the sequence as
@@ -85,8 +86,8 @@ def main() -> int:
     args = ap.parse_args()
     found = glob.glob(os.path.join(args.work_dir, "template_keyframe_*.obj"))
     if len(found) != 1:
-        print(f"{args.work_dir}: expected one template_keyframe_<K>.obj (a neupig fit's), found {len(found)}",
-              file=sys.stderr)
+        print(f"{args.work_dir}: expected one template_keyframe_<K>.obj (a neupig, pdg or dynosurf fit's), "
+              f"found {len(found)}", file=sys.stderr)
         return 2
     key = int(re.search(r"template_keyframe_(\d+)\.obj$", found[0]).group(1))
     dataset, _, sequence = args.sequence.partition("/")
