@@ -226,6 +226,8 @@ static cJSON *manifest(const void *self, size_t n_params)
     return j;
 }
 
+static void main_phase(void *trainer) { dyno_trainer_main_phase(trainer); }
+
 static const tcb_pcgrid_hooks hooks = {
     .name = "dynosurf", .magic = "TCBDYNM1",
     .problem_size = sizeof(problem), .trainer_size = sizeof(dyno_trainer),
@@ -234,12 +236,13 @@ static const tcb_pcgrid_hooks hooks = {
     .step = step, .done = done, .save = save, .load = load,
     .params = params, .frames = frames, .manifest = manifest,
     .frame_map = dyno_frame_map, .keyframe = dyno_keyframe, .trained_template = trained_template,
-    .describe = describe,
+    .describe = describe, .main_phase = main_phase,
 };
 
-/* No estimate and no calibration yet: a step's cost differs by phase by
- * orders of magnitude, and stage 2, which dominates, needs stage 1's
- * template first (docs/protocol.md, "DynoSurf"). */
+/* train_steps times stage 2 (dyno_trainer_main_phase), for
+ * bench_train_step. No estimate yet: the four phases' steps cost
+ * differently, and only stage 2's grows with the frames
+ * (docs/protocol.md, "DynoSurf"). */
 const tcb_method_ops tcb_method_dynosurf = {
     .abi_version = TCB_METHOD_ABI_VERSION,
     .name = "dynosurf",
@@ -253,5 +256,6 @@ const tcb_method_ops tcb_method_dynosurf = {
     .load = tcb_pcgrid_load,
     .destroy = tcb_pcgrid_destroy,
     .surface = tcb_pcgrid_surface_op,
+    .train_steps = tcb_pcgrid_train_steps,
     .normals = tcb_pcgrid_normals_used,
 };

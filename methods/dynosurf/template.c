@@ -73,6 +73,14 @@ int dyno_template_extract(dyno_template_fit *f, const dyno_shape *s, tcb_mt_surf
     return tcb_marching_tets_forward(f->v, f->sdf, f->grid->n_verts, f->grid->tets, f->grid->n_tets, out, err);
 }
 
+int dyno_template_extract_target(dyno_template_fit *f, const float *d, tcb_mt_surface *out, tcb_error *err)
+{
+    size_t nv = (size_t)f->grid->n_verts;
+    memcpy(f->v, f->grid->verts, nv * 3 * sizeof *f->v);
+    memcpy(f->sdf, d, nv * sizeof *f->sdf);
+    return tcb_marching_tets_forward(f->v, f->sdf, f->grid->n_verts, f->grid->tets, f->grid->n_tets, out, err);
+}
+
 static double sgn(double v) { return (v > 0) - (v < 0); }
 
 /* The L1 term 50 · mean |sdf − s(v)|: its value, ∂/∂sdf into f->dsdf and

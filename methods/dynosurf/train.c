@@ -88,7 +88,8 @@ static int prepare_motion(dyno_trainer *t, tcb_error *err)
     if (t->motion_ready) return TCB_OK;
     const dyno_problem *p = t->p;
     size_t nv = (size_t)p->grid->n_verts;
-    int rc = dyno_template_extract(&t->tfit, &t->shape, &t->templ, err);
+    int rc = t->template_from_target ? dyno_template_extract_target(&t->tfit, p->hull_sd, &t->templ, err)
+                                     : dyno_template_extract(&t->tfit, &t->shape, &t->templ, err);
     if (!rc && t->templ.n_faces == 0)
         rc = tcb_fail(err, TCB_ERR_NUMERIC, "dynosurf: the template after stage 1 is empty (its SDF has one sign)");
     if (!rc && (!(t->grid_v = malloc(nv * 3 * sizeof(float))) || !(t->grid_sdf = malloc(nv * sizeof(float)))))
@@ -138,6 +139,13 @@ static int phase_loss(dyno_trainer *t, int phase, double *loss, tcb_error *err)
         return rc;
     }
     }
+}
+
+void dyno_trainer_main_phase(dyno_trainer *t)
+{
+    release_motion(t);
+    t->template_from_target = 1;
+    t->it = t->s.steps[DYNO_PHASE_PRETRAIN] + t->s.steps[DYNO_PHASE_TEMPLATE] + t->s.steps[DYNO_PHASE_BLEND];
 }
 
 int dyno_train_step(dyno_trainer *t, double *loss, tcb_error *err)
@@ -210,6 +218,6 @@ int dyno_train_load(dyno_trainer *t, uint64_t seed, const char *path, double *se
 {
     tcb_ckpt_spec s = spec_of(t, seed);
     int rc = tcb_ckpt_spec_load(&s, path, seconds, err);
-    if (!rc) release_motion(t); /* the template follows the loaded weights */
+    if (!rc) release_motion(t), t->template_from_target = 0; /* the template follows the loaded weights */
     return rc;
 }

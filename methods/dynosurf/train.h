@@ -68,8 +68,9 @@ typedef struct dyno_trainer {
     dyno_template_fit tfit;
     dyno_blend bpre;
     float *blend_pts;           /* [blend_points][3] */
-    /* Stage 2's template, extracted from the frozen shape network. */
-    int motion_ready;
+    /* Stage 2's template, extracted from the frozen shape network (or,
+     * after dyno_trainer_main_phase, from the pretraining's target). */
+    int motion_ready, template_from_target;
     tcb_mt_surface templ;
     float *grid_v, *grid_sdf;   /* the deformed grid and its SDF */
     dyno_motion_fit mfit;
@@ -84,6 +85,15 @@ void dyno_trainer_free(dyno_trainer *t);
 long long dyno_total_steps(const dyno_schedule *s);
 /* The phase of iteration it and the iteration it starts at. */
 int dyno_phase_of(const dyno_schedule *s, long long it, long long *start);
+
+/* train_steps' calibration (tcbench calibrate, bench_train_step): a fresh
+ * trainer moved to stage 2's first step, the phase that dominates a fit
+ * (docs/protocol.md, "DynoSurf": about half of a `cpu` fit's time, and
+ * the phase that grows with the frames). Its template is the zero set of
+ * the hull's signed distance, the pretraining's target, instead of stage
+ * 1's; the deformer as initialised. A step then costs what a fit's
+ * stage-2 step costs on a template of that size. */
+void dyno_trainer_main_phase(dyno_trainer *t);
 
 /* One iteration of whichever phase it is in. */
 int dyno_train_step(dyno_trainer *t, double *loss, tcb_error *err);

@@ -169,11 +169,51 @@ static void test_resume(void **state)
     free(final_params);
 }
 
+/* train_steps' calibration: stage 2 from its first step, on the hull's
+ * zero set, moving the deformer alone. */
+static void test_main_phase(void **state)
+{
+    (void)state;
+    dyno_schedule s = schedule();
+    dyno_trainer t;
+    tcb_error err = {0};
+    double loss;
+    assert_int_equal(dyno_trainer_init(&t, &fx->p, &s, 7, &err), TCB_OK);
+    dyno_trainer_main_phase(&t);
+    long long start;
+    assert_int_equal(dyno_phase_of(&s, t.it, &start), DYNO_PHASE_MOTION);
+    assert_true(t.it == start);
+    float *before = malloc(t.n_params * sizeof *before);
+    memcpy(before, t.params, t.n_params * sizeof *before);
+    assert_int_equal(dyno_train_step(&t, &loss, &err), TCB_OK);
+    assert_true(isfinite(loss) && loss > 0);
+    int m[3];
+    moved(&t, before, m);
+    assert_int_equal(m[0], 0), assert_int_equal(m[1], 1), assert_int_equal(m[2], 1);
+    const tcb_mt_surface *templ;
+    assert_int_equal(dyno_trainer_template(&t, &templ, &err), TCB_OK);
+    assert_true(templ->n_faces > 100);
+    /* the hull's zero set on the undeformed grid: each vertex where the
+     * hull's signed distance, linear along its grid edge, crosses zero */
+    for (int i = 0; i < templ->n_verts; i++) {
+        int a = templ->edges[2 * i], b = templ->edges[2 * i + 1];
+        double da = fx->sd[a], db = fx->sd[b], w = da / (da - db);
+        assert_true(da * db < 0);
+        for (int k = 0; k < 3; k++) {
+            double pa = fx->grid.verts[3 * a + k], pb = fx->grid.verts[3 * b + k];
+            assert_true(fabs(templ->verts[3 * i + k] - (pa + w * (pb - pa))) < 1e-5);
+        }
+    }
+    free(before);
+    dyno_trainer_free(&t);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_phases),
         cmocka_unit_test(test_resume),
+        cmocka_unit_test(test_main_phase),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
