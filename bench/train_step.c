@@ -74,6 +74,19 @@
  * searches, scattered trilinear samples and small solves, no product a
  * FLOP peak would measure.
  *
+ * dynosurf (one step of stage 2, its train_steps' main phase: the
+ * template carried into every frame by the 30 control points, surface
+ * samples, the robust Chamfer and normal terms, the keyframe's identity,
+ * the SDF sign on grid picks, the smoothness, backward, Adam) at the cpu
+ * preset's sizes and the paper's, on the calibration sequence's 6 frames,
+ * its template the zero set of the hull's signed distance (the
+ * pretraining's target; dyno_trainer_main_phase). The peer
+ * train_step_dynosurf_torch.py (tests/pytorch/dynosurf_torch.py's pieces,
+ * float32, torch.optim.Adam) trains on the C training's data. GFLOP/it
+ * counts the blend network, (template vertices + grid picks) x 30 rows
+ * through 6 -> 128 x 5 -> 1, forward and 2x backward: the dominant product
+ * is its hidden layer.
+ *
  * Targets (issue 41): every paper-scale step ≥ 5× PyTorch at 1 thread,
  * the GEMM-dominated steps at ≥ 60 % of the sgemm rate on their own
  * dominant product (%shp). The column `ceiling` bounds the first: the
@@ -86,11 +99,12 @@
  *                         [--method NAME] [--no-torch]
  *                         [--torch SCRIPT] [--cc-torch SCRIPT]
  *                         [--neupig-torch SCRIPT] [--pdg-torch SCRIPT]
- *                         [--losses]
+ *                         [--dynosurf-torch SCRIPT] [--losses]
  * Defaults: 5 iterations, the OpenMP thread count, all presets and methods
- * (atlasnet, dsr, mca, cc, neupig, pdg), the peers train_step_torch.py,
- * train_step_cc_torch.py, train_step_neupig_torch.py and
- * train_step_pdg_torch.py next to this file run by /usr/bin/python3. */
+ * (atlasnet, dsr, mca, cc, neupig, pdg, dynosurf), the peers
+ * train_step_torch.py, train_step_cc_torch.py, train_step_neupig_torch.py,
+ * train_step_pdg_torch.py and train_step_dynosurf_torch.py next to this
+ * file run by /usr/bin/python3. */
 #include <cblas.h>
 #include <dirent.h>
 #include <math.h>
@@ -105,6 +119,7 @@
 #include "atlas_bench.h"
 #include "cc_bench.h"
 #include "costs/step_timing.h"
+#include "methods/dynosurf/train.h"
 #include "methods/pcgrid/method.h"
 #include "methods/pdg/train.h"
 #include "tcb/mesh_io.h"
@@ -151,7 +166,7 @@ typedef struct {
     char dominant[64];   /* print_row's scratch */
     const char *preset; /* NULL: all */
     const char *method; /* NULL: all */
-    char script[4096], cc_script[4096], neupig_script[4096], pdg_script[4096];
+    char script[4096], cc_script[4096], neupig_script[4096], pdg_script[4096], dynosurf_script[4096];
 } options;
 
 #define die(...) bench_die("bench_train_step", __VA_ARGS__)
@@ -378,6 +393,8 @@ static void print_header(const options *o)
            "neupig (one epoch: every frame; tcb_neupig_train_step): the MLP T*nv*(Din*H + H^2 + 7H),\n"
            "  backward 2x; grids, Chamfer and edge terms not counted.\n"
            "pdg (one epoch after the warm-up: every transition and chain; tcb_pdg_train_step): not counted (-).\n"
+           "dynosurf (one step of stage 2, every frame): the blend network (nv + picks)*30*(6H + 4H^2 + H),\n"
+           "  backward 2x; the transform network, samples, Chamfers and SDF terms not counted.\n"
            "Losses, nearest neighbours and Adam not counted.\n"
            "This machine's sgemm (OpenBLAS, %d thread(s), measured now): %.1f GFLOP/s on 2048^3;\n"
            "  %%sq: the step's GFLOP/s over it, %%shp: over sgemm on the step's dominant product (shape m x n x k);\n"
@@ -498,6 +515,85 @@ static void run_pdg_row(options *o, const preset *p, const tcb_sequence *seq)
     print_row(o, p->name, "pdg", -1, (gemm_shape){0, 0, 0}, ms, rc, tms, rss, o->pdg_script);
 }
 
+/* [rows][cols] float32 data as dir/name.npy (save_rows' for other widths). */
+static int save_matrix(const char *dir, const char *name, int rows, int cols, const float *data, tcb_error *err)
+{
+    char path[128];
+    const uint64_t shape[2] = {(uint64_t)rows, (uint64_t)cols};
+    snprintf(path, sizeof path, "%s/%s.npy", dir, name);
+    return tcb_npy_save(path, TCB_NPY_F4, 2, shape, data, err);
+}
+
+/* The dynosurf peer's data and command: the C training's stage 2 (self's
+ * train_steps) written to a new temporary directory dir: every frame's
+ * points and normals in DynoSurf's frame (points_<t>.npy, normals_<t>.npy),
+ * the template (template_verts.npy, template_faces.npy), the grid and its
+ * SDF (grid_verts.npy, grid_sdf.npy), the deformer's parameters as they
+ * started (deformer.npy: control points, MLP_T, MLP_W); frames, keyframe,
+ * samples and grid picks on the command line. -1 when it does not fit. */
+static int dynosurf_peer(const options *o, const void *self, const float *deformer, char *dir, char *cmd, size_t size)
+{
+    const void *state;
+    tcb_pcgrid_steps_inputs(self, &state);
+    const dyno_trainer *t = state;
+    const dyno_problem *p = t->p;
+    tcb_error err = {0};
+    if (!mkdtemp(dir)) die("cannot create a temporary directory in /tmp");
+    int rc = save_rows(dir, "template_verts", TCB_NPY_F4, t->templ.n_verts, t->templ.verts, &err);
+    if (!rc) rc = save_rows(dir, "template_faces", TCB_NPY_I4, t->templ.n_faces, t->templ.faces, &err);
+    if (!rc) rc = save_rows(dir, "grid_verts", TCB_NPY_F4, p->grid->n_verts, t->grid_v, &err);
+    if (!rc) rc = save_matrix(dir, "grid_sdf", p->grid->n_verts, 1, t->grid_sdf, &err);
+    if (!rc) rc = save_matrix(dir, "deformer", 1, (int)(t->n_params - t->n_shape), deformer, &err);
+    for (int k = 0; !rc && k < p->T; k++) {
+        char name[32];
+        snprintf(name, sizeof name, "points_%d", k);
+        rc = save_rows(dir, name, TCB_NPY_F4, p->n_pts[k], p->pts[k], &err);
+        snprintf(name, sizeof name, "normals_%d", k);
+        if (!rc) rc = save_rows(dir, name, TCB_NPY_F4, p->n_pts[k], p->normals[k], &err);
+    }
+    if (rc) die("dynosurf: %s", err.msg);
+    return (size_t)snprintf(cmd, size, "/usr/bin/python3 '%s' '%s' %d %d %d %d %zu %d %d", o->dynosurf_script, dir,
+                            p->T, p->key, t->s.samples, t->s.grid_samples, dyno_deformer_blend_offset(), o->iters,
+                            o->threads) < size ? 0 : -1;
+}
+
+/* dynosurf at preset p: stage 2's step (its train_steps, main phase);
+ * GFLOP/it counts the blend network over the template's vertices and the
+ * grid picks, each against every control point (the transform network's
+ * F·K rows are noise beside it), forward and twice that backward. */
+static void run_dynosurf_row(options *o, const preset *p, const tcb_sequence *seq)
+{
+    const tcb_method_ops *ops;
+    void *self = create_at("dynosurf", p->name, &ops);
+    tcb_fit_ctx ctx = {.seed = 1, .n_threads = o->threads};
+    tcb_error err = {0};
+    /* one untimed step builds the trainer, so that the deformer's start
+     * can be kept for the peer before the timed steps move it */
+    if (ops->train_steps(self, seq, &ctx, 0, &err)) die("dynosurf: %s", err.msg);
+    const void *state;
+    tcb_pcgrid_steps_inputs(self, &state);
+    const dyno_trainer *t = state;
+    size_t nd = t->n_params - t->n_shape;
+    float *deformer = malloc(nd * sizeof *deformer);
+    if (!deformer) die("dynosurf: out of memory");
+    memcpy(deformer, t->params + t->n_shape, nd * sizeof *deformer);
+    double tms = 0, ms = time_steps(ops, self, seq, o);
+    long long rows = (long long)(t->templ.n_verts + t->s.grid_samples) * DYNO_CONTROL_POINTS;
+    const double h = DYNO_DEFORM_WIDTH;
+    double fwd = (double)rows * (DYNO_BLEND_IN * h + (DYNO_DEFORM_LAYERS - 2) * h * h + h);
+    char dir[] = "/tmp/bench_train_step_XXXXXX", cmd[8192];
+    int rc = o->torch ? dynosurf_peer(o, self, deformer, dir, cmd, sizeof cmd) : PEER_SKIPPED;
+    ops->destroy(self);
+    free(deformer);
+    long rss = 0;
+    if (o->torch) {
+        if (rc == 0) rc = run_peer(cmd, &tms, &rss);
+        remove_dir(dir);
+    }
+    print_row(o, p->name, "dynosurf", 2 * 3 * fwd * 1e-9, (gemm_shape){(int)rows, (int)h, (int)h}, ms, rc, tms, rss,
+              o->dynosurf_script);
+}
+
 static void parse(int argc, char **argv, options *o)
 {
     *o = (options){.iters = 5, .threads = omp_get_max_threads(), .torch = 1};
@@ -505,6 +601,7 @@ static void parse(int argc, char **argv, options *o)
     bench_sibling_path(o->cc_script, sizeof o->cc_script, __FILE__, "train_step_cc_torch.py");
     bench_sibling_path(o->neupig_script, sizeof o->neupig_script, __FILE__, "train_step_neupig_torch.py");
     bench_sibling_path(o->pdg_script, sizeof o->pdg_script, __FILE__, "train_step_pdg_torch.py");
+    bench_sibling_path(o->dynosurf_script, sizeof o->dynosurf_script, __FILE__, "train_step_dynosurf_torch.py");
     for (int a = 1; a < argc; a++) {
         const char *v = a + 1 < argc ? argv[a + 1] : NULL;
         if (strcmp(argv[a], "--no-torch") == 0) o->torch = 0;
@@ -522,13 +619,16 @@ static void parse(int argc, char **argv, options *o)
             snprintf(o->neupig_script, sizeof o->neupig_script, "%s", v), a++;
         else if (strcmp(argv[a], "--pdg-torch") == 0)
             snprintf(o->pdg_script, sizeof o->pdg_script, "%s", v), a++;
+        else if (strcmp(argv[a], "--dynosurf-torch") == 0)
+            snprintf(o->dynosurf_script, sizeof o->dynosurf_script, "%s", v), a++;
         else die("bad argument %s (usage: top of bench/train_step.c)", argv[a]);
     }
     if (o->preset && strcmp(o->preset, "cpu") && strcmp(o->preset, "paper"))
         die("--preset must be paper, cpu or all");
     if (o->method && strcmp(o->method, "atlasnet") && strcmp(o->method, "dsr") && strcmp(o->method, "mca") &&
-        strcmp(o->method, "cc") && strcmp(o->method, "neupig") && strcmp(o->method, "pdg"))
-        die("--method must be atlasnet, dsr, mca, cc, neupig or pdg");
+        strcmp(o->method, "cc") && strcmp(o->method, "neupig") && strcmp(o->method, "pdg") &&
+        strcmp(o->method, "dynosurf"))
+        die("--method must be atlasnet, dsr, mca, cc, neupig, pdg or dynosurf");
 }
 
 int main(int argc, char **argv)
@@ -549,6 +649,7 @@ int main(int argc, char **argv)
         if (want && (!o.method || strcmp(o.method, "cc") == 0)) run_cc_row(&o, &cc_presets[i], &seq);
         if (want && (!o.method || strcmp(o.method, "neupig") == 0)) run_neupig_row(&o, &presets[i], &neupig_presets[i], &seq);
         if (want && (!o.method || strcmp(o.method, "pdg") == 0)) run_pdg_row(&o, &presets[i], &seq);
+        if (want && (!o.method || strcmp(o.method, "dynosurf") == 0)) run_dynosurf_row(&o, &presets[i], &seq);
     }
     tcb_sequence_free(&seq);
     /* last: its 0.5 GB would otherwise be every C row's peak RSS */

@@ -102,10 +102,11 @@ def chamfer_l1(x, nx, y, ny):
     return cham, normal
 
 
-def approx_sdf(v, p, n, k=10, r=0.1):
+def approx_sdf(v, p, n, k=10, r=0.1, search=torch.float64):
     """approximate_sdf_loss's target: over the k nearest points,
-    softmax(exp(−d²/r²)) weights of n·(v − p)."""
-    d2 = torch.cdist(v.detach().double(), p.double()) ** 2
+    softmax(exp(−d²/r²)) weights of n·(v − p). The neighbours are searched
+    in `search` (float64: the checks' exact ties; the bench's peer float32)."""
+    d2 = torch.cdist(v.detach().to(search), p.to(search)) ** 2
     idx = d2.topk(k, dim=1, largest=False).indices
     diff = v[:, None, :] - p[idx]
     pp = diff.norm(dim=-1)
