@@ -36,7 +36,7 @@ cat > grid.json <<'JSON'
   "datasets": [ { "name": "synth", "source": "synthetic", "frames": 6,
                   "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
   "methods": [ { "name": "nearest" },
-               { "name": "mca", "params": { "preset": "tiny", "iterations": 100, "checkpoint_every": 0 } } ] }
+               { "name": "mca", "params": { "preset": "tiny", "iterations": 30, "checkpoint_every": 0 } } ] }
 JSON
 "$TCBENCH" run grid.json --out plain --quiet 2> /dev/null
 TCBENCH="$TCBENCH" "$TCB_SOURCE_DIR/scripts/slurm/submit.sh" grid.json --out "$tmp/slurm" \
@@ -53,7 +53,7 @@ cat > clips.json <<'JSON'
   "datasets": [ { "name": "synth", "source": "synthetic", "frames": 20, "normalization": "clip_bbox",
                   "sequences": [ { "name": "quadruped_walk", "role": "test", "clip_starts": [0, 3] } ] } ],
   "methods": [ { "name": "nearest" },
-               { "name": "mca", "params": { "preset": "tiny", "iterations": 60, "checkpoint_every": 0 } } ] }
+               { "name": "mca", "params": { "preset": "tiny", "iterations": 20, "checkpoint_every": 0 } } ] }
 JSON
 "$TCBENCH" run clips.json --out clips-plain --quiet 2> /dev/null
 TCBENCH="$TCBENCH" "$TCB_SOURCE_DIR/scripts/slurm/submit.sh" clips.json --tasks 2 --out "$tmp/clips-slurm" \
@@ -62,7 +62,7 @@ TCBENCH="$TCBENCH" "$TCB_SOURCE_DIR/scripts/slurm/submit.sh" clips.json --tasks 
 same_cells clips-plain clips-slurm
 
 # Stops: three trainings (cells 1-3) after a nearest cell (0), one-CPU tasks.
-sed 's/"iterations": 100/"iterations": 800/; s/"seeds": \[0, 1\]/"seeds": [0, 1, 2]/
+sed 's/"iterations": 30/"iterations": 800/; s/"seeds": \[0, 1\]/"seeds": [0, 1, 2]/
      s/{ "name": "nearest" }/{ "name": "nearest", "seeds": [0] }/' grid.json > long.json
 # The uninterrupted cells, by two local runs sharing the cells, meanwhile.
 refs=()
