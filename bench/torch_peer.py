@@ -39,6 +39,15 @@ def keep_freed_memory():
     libc.mallopt(M_TRIM_THRESHOLD, 1 << 30)
 
 
+def start(torch, threads, seed=None):
+    """What every peer does first: torch on `threads` threads, freed memory
+    kept (keep_freed_memory), torch's generator seeded unless seed is None."""
+    torch.set_num_threads(threads)
+    keep_freed_memory()
+    if seed is not None:
+        torch.manual_seed(seed)
+
+
 def edges(faces):
     """The undirected edges [ne][2] (smaller index first, each once) of
     the triangles faces [nf][3] (a long tensor)."""

@@ -63,9 +63,7 @@ def draw(verts, faces, n):
 def main():
     data = sys.argv[1]
     F, key, samples, picks, blend_offset, iters, threads = (int(x) for x in sys.argv[2:9])
-    torch.set_num_threads(threads)
-    torch_peer.keep_freed_memory()
-    torch.manual_seed(0)
+    torch_peer.start(torch, threads, 0)
     load = lambda name: torch.from_numpy(np.load(f"{data}/{name}.npy"))
     tv, tf = load("template_verts"), load("template_faces").long()
     grid_v, grid_sdf = load("grid_verts"), load("grid_sdf")[:, 0]

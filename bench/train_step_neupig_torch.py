@@ -69,9 +69,7 @@ def problem(path, frames, points):
 def main():
     path = sys.argv[1]
     frames, points, levels, features, hidden, iters, threads = (int(x) for x in sys.argv[2:9])
-    torch.set_num_threads(threads)
-    torch_peer.keep_freed_memory()
-    torch.manual_seed(1)
+    torch_peer.start(torch, threads, 1)
     a = nt.Arch(levels, 2, 3, features, 4, 2, 4, hidden, 0.4, 1.5, 0.4, 100.0, 0.3)
     prob = problem(path, frames, points)
     grids = [torch.zeros(r ** 3 * w, requires_grad=True) for r, w in zip(nt.resolutions(a), nt.widths(a))]

@@ -80,8 +80,7 @@ def main():
     data = sys.argv[1]
     frames, key, epochs, levels, iters, threads = (int(x) for x in sys.argv[2:8])
     losses = sys.argv[8:] == ["--losses"]
-    torch.set_num_threads(threads)
-    torch_peer.keep_freed_memory()
+    torch_peer.start(torch, threads)
 
     def load(name):
         return torch.from_numpy(np.load(os.path.join(data, name)))

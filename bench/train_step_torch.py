@@ -27,9 +27,7 @@ def main():
     method = sys.argv[1]
     c, p, m, n, iters, threads = (int(a) for a in sys.argv[2:8])
     warmup = int(sys.argv[8]) if len(sys.argv) > 8 else 1
-    torch.set_num_threads(threads)
-    torch_peer.keep_freed_memory()
-    torch.manual_seed(1)
+    torch_peer.start(torch, threads, 1)
     model = atlas_torch.Atlas(c, p)
     opt = torch.optim.Adam(model.parameters(), lr=1e-3)
     clouds = torch.rand(BATCH, n, 3) - 0.5
