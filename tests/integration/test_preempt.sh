@@ -58,7 +58,7 @@ same_cells full stopped
 cat > maps.json <<'JSON'
 { "name": "maps", "splits_dir": "maps_splits", "cache_dir": "", "seeds": [0], "threads": 1,
   "evaluation": { "pairs": 20, "pool_size": 1000, "input_points": 300, "surface_samples": 500 },
-  "datasets": [ { "name": "synth", "source": "synthetic", "frames": 24,
+  "datasets": [ { "name": "synth", "source": "synthetic", "frames": 12,
                   "sequences": [ { "name": "quadruped_walk", "role": "validation" } ] } ],
   "methods": [ { "name": "nricp", "params": { "strategy": "propagate_bijective" } } ] }
 JSON
@@ -69,12 +69,12 @@ CI= "$TCBENCH" run maps.json --out maps_stopped 2> maps_term.log &
 pid=$!
 rc=0; stop_when TERM maps_term.log "nricp: consecutive maps: " || rc=$?
 [ "$rc" -eq 75 ] || { echo "FAIL: nricp: exit $rc after SIGTERM, expected 75"; cat maps_term.log; exit 1; }
-grep -q "stopped after [1-9][0-9]* of 46 consecutive maps; maps saved in .*nricp_maps.partial" maps_term.log ||
+grep -q "stopped after [1-9][0-9]* of 22 consecutive maps; maps saved in .*nricp_maps.partial" maps_term.log ||
     { cat maps_term.log; exit 1; }
 [ -s "maps_stopped/$work/nricp_maps.partial" ] && [ ! -e "maps_stopped/$cell" ] ||
     { echo "FAIL: expected the partial maps and no cell"; find maps_stopped; exit 1; }
 CI= "$TCBENCH" run maps.json --out maps_stopped 2> maps_resume.log
-grep -q "resuming the consecutive maps with [1-9][0-9]* of 46 done" maps_resume.log ||
+grep -q "resuming the consecutive maps with [1-9][0-9]* of 22 done" maps_resume.log ||
     { echo "FAIL: nricp did not resume"; cat maps_resume.log; exit 1; }
 [ ! -e "maps_stopped/$work/nricp_maps.partial" ] || { echo "FAIL: the partial maps were left behind"; exit 1; }
 same_cells maps_full maps_stopped
