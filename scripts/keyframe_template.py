@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """A template method's keyframe template against the keyframe's ground-truth mesh.
 
-    scripts/keyframe_template.py CONFIG DATASET/SEQUENCE WORK_DIR [--samples N] [--seed S] [--clip-start S]
+    scripts/keyframe_template.py CONFIG DATASET/SEQUENCE WORK_DIR [--samples N] [--seed S]
 
 WORK_DIR is a neupig, pdg or dynosurf cell's work directory (runs/<run>/
 work/<dataset>/<sequence>/<method>/seed_<s>), where its fit wrote
@@ -15,9 +15,9 @@ faces; and sqrt(Chamfer)/diagonal against frame K of the sequence as
 of the two mean squared nearest distances between N area-uniform samples of
 each surface (scipy's cKDTree) and the diagonal the GT frame's bounding box.
 Independent of the C code: numpy and scipy only, the mesh read from the OBJ.
-A per-clip fit (the clip protocol's "fit": "per_clip") saw only its clip:
---clip-start S names the clip's first frame, and its keyframe K is then
-frame S + K of the sequence.
+A per-clip fit (the clip protocol's "fit": "per_clip") is named by its
+clip, DATASET/<sequence>_<start> (ama/crane_0010), which loads as the
+17-frame sequence the fit saw.
 """
 
 from __future__ import annotations
@@ -86,8 +86,6 @@ def main() -> int:
     ap.add_argument("work_dir")
     ap.add_argument("--samples", type=int, default=100_000)
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--clip-start", type=int, default=0,
-                    help="a per-clip fit's first frame in the sequence (its keyframe is counted from it)")
     args = ap.parse_args()
     found = glob.glob(os.path.join(args.work_dir, "template_keyframe_*.obj"))
     if len(found) != 1:
@@ -98,12 +96,7 @@ def main() -> int:
     dataset, _, sequence = args.sequence.partition("/")
     import tcbench  # the C library's own loading, normalisation and alignment
     seq = tcbench.load_sequence(args.config, dataset, sequence)
-    frame = args.clip_start + key
-    if not 0 <= frame < seq["n_frames"]:
-        print(f"{args.sequence}: no frame {frame} (clip start {args.clip_start} + keyframe {key}) "
-              f"of {seq['n_frames']}", file=sys.stderr)
-        return 2
-    gt_verts = seq["verts"][frame].astype(np.float64)
+    gt_verts = seq["verts"][key].astype(np.float64)
     gt_faces = seq["faces"].astype(np.int64)
 
     verts, faces = read_obj(found[0])
@@ -114,7 +107,7 @@ def main() -> int:
     rng = np.random.default_rng(args.seed)
     cd = chamfer(sample_surface(verts, faces, args.samples, rng), sample_surface(gt_verts, gt_faces, args.samples, rng))
     diag = float(np.linalg.norm(gt_verts.max(axis=0) - gt_verts.min(axis=0)))
-    print(f"template        {found[0]} (keyframe {key}: frame {frame} of {seq['n_frames']})")
+    print(f"template        {found[0]} (keyframe {key} of {seq['n_frames']})")
     print(f"vertices        {len(verts)}")
     print(f"faces           {len(faces)} (GT frame: {len(gt_verts)} vertices, {len(gt_faces)} faces)")
     print(f"boundary edges  {int(np.sum(per_edge == 1))}")
