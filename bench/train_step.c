@@ -337,11 +337,12 @@ static int time_neupig_torch(const options *o, const neupig_preset *pr, const ch
     return run_peer(cmd, ms, rss_kib);
 }
 
-/* [rows][3] of data as dir/name.npy. */
-static int save_rows(const char *dir, const char *name, tcb_npy_dtype dtype, int rows, const void *data, tcb_error *err)
+/* [rows][cols] of data as dir/name.npy. */
+static int save_npy(const char *dir, const char *name, tcb_npy_dtype dtype, int rows, int cols, const void *data,
+                    tcb_error *err)
 {
     char path[128];
-    const uint64_t shape[2] = {(uint64_t)rows, 3};
+    const uint64_t shape[2] = {(uint64_t)rows, (uint64_t)cols};
     snprintf(path, sizeof path, "%s/%s.npy", dir, name);
     return tcb_npy_save(path, dtype, 2, shape, data, err);
 }
@@ -359,12 +360,12 @@ static int pdg_peer(const options *o, const void *self, char *dir, char *cmd, si
     const tcb_mesh *m = in->template_mesh;
     tcb_error err = {0};
     if (!mkdtemp(dir)) die("cannot create a temporary directory in /tmp");
-    int rc = save_rows(dir, "template_verts", TCB_NPY_F4, m->n_verts, m->verts, &err);
-    if (!rc) rc = save_rows(dir, "template_faces", TCB_NPY_I4, m->n_faces, m->faces, &err);
+    int rc = save_npy(dir, "template_verts", TCB_NPY_F4, m->n_verts, 3, m->verts, &err);
+    if (!rc) rc = save_npy(dir, "template_faces", TCB_NPY_I4, m->n_faces, 3, m->faces, &err);
     for (int k = 0; !rc && k < in->clouds.T; k++) {
         char name[32];
         snprintf(name, sizeof name, "points_%d", k);
-        rc = save_rows(dir, name, TCB_NPY_F4, in->clouds.n[k], in->clouds.clouds[k], &err);
+        rc = save_npy(dir, name, TCB_NPY_F4, in->clouds.n[k], 3, in->clouds.clouds[k], &err);
     }
     if (rc) die("pdg: %s", err.msg);
     return (size_t)snprintf(cmd, size, "/usr/bin/python3 '%s' '%s' %d %d %lld %d %d %d%s", o->pdg_script, dir,
@@ -515,15 +516,6 @@ static void run_pdg_row(options *o, const preset *p, const tcb_sequence *seq)
     print_row(o, p->name, "pdg", -1, (gemm_shape){0, 0, 0}, ms, rc, tms, rss, o->pdg_script);
 }
 
-/* [rows][cols] float32 data as dir/name.npy (save_rows' for other widths). */
-static int save_matrix(const char *dir, const char *name, int rows, int cols, const float *data, tcb_error *err)
-{
-    char path[128];
-    const uint64_t shape[2] = {(uint64_t)rows, (uint64_t)cols};
-    snprintf(path, sizeof path, "%s/%s.npy", dir, name);
-    return tcb_npy_save(path, TCB_NPY_F4, 2, shape, data, err);
-}
-
 /* The dynosurf peer's data and command: the C training's stage 2 (self's
  * train_steps) written to a new temporary directory dir: every frame's
  * points and normals in DynoSurf's frame (points_<t>.npy, normals_<t>.npy),
@@ -539,17 +531,17 @@ static int dynosurf_peer(const options *o, const void *self, const float *deform
     const dyno_problem *p = t->p;
     tcb_error err = {0};
     if (!mkdtemp(dir)) die("cannot create a temporary directory in /tmp");
-    int rc = save_rows(dir, "template_verts", TCB_NPY_F4, t->templ.n_verts, t->templ.verts, &err);
-    if (!rc) rc = save_rows(dir, "template_faces", TCB_NPY_I4, t->templ.n_faces, t->templ.faces, &err);
-    if (!rc) rc = save_rows(dir, "grid_verts", TCB_NPY_F4, p->grid->n_verts, t->grid_v, &err);
-    if (!rc) rc = save_matrix(dir, "grid_sdf", p->grid->n_verts, 1, t->grid_sdf, &err);
-    if (!rc) rc = save_matrix(dir, "deformer", 1, (int)(t->n_params - t->n_shape), deformer, &err);
+    int rc = save_npy(dir, "template_verts", TCB_NPY_F4, t->templ.n_verts, 3, t->templ.verts, &err);
+    if (!rc) rc = save_npy(dir, "template_faces", TCB_NPY_I4, t->templ.n_faces, 3, t->templ.faces, &err);
+    if (!rc) rc = save_npy(dir, "grid_verts", TCB_NPY_F4, p->grid->n_verts, 3, t->grid_v, &err);
+    if (!rc) rc = save_npy(dir, "grid_sdf", TCB_NPY_F4, p->grid->n_verts, 1, t->grid_sdf, &err);
+    if (!rc) rc = save_npy(dir, "deformer", TCB_NPY_F4, 1, (int)(t->n_params - t->n_shape), deformer, &err);
     for (int k = 0; !rc && k < p->T; k++) {
         char name[32];
         snprintf(name, sizeof name, "points_%d", k);
-        rc = save_rows(dir, name, TCB_NPY_F4, p->n_pts[k], p->pts[k], &err);
+        rc = save_npy(dir, name, TCB_NPY_F4, p->n_pts[k], 3, p->pts[k], &err);
         snprintf(name, sizeof name, "normals_%d", k);
-        if (!rc) rc = save_rows(dir, name, TCB_NPY_F4, p->n_pts[k], p->normals[k], &err);
+        if (!rc) rc = save_npy(dir, name, TCB_NPY_F4, p->n_pts[k], 3, p->normals[k], &err);
     }
     if (rc) die("dynosurf: %s", err.msg);
     return (size_t)snprintf(cmd, size, "/usr/bin/python3 '%s' '%s' %d %d %d %d %zu %d %d", o->dynosurf_script, dir,
@@ -567,7 +559,7 @@ static void run_dynosurf_row(options *o, const preset *p, const tcb_sequence *se
     void *self = create_at("dynosurf", p->name, &ops);
     tcb_fit_ctx ctx = {.seed = 1, .n_threads = o->threads};
     tcb_error err = {0};
-    /* one untimed step builds the trainer, so that the deformer's start
+    /* a call of no steps builds the trainer, so that the deformer's start
      * can be kept for the peer before the timed steps move it */
     if (ops->train_steps(self, seq, &ctx, 0, &err)) die("dynosurf: %s", err.msg);
     const void *state;

@@ -84,7 +84,9 @@ int dyno_template_extract(dyno_template_fit *f, const dyno_shape *s, tcb_mt_surf
 /* The zero set of the pretraining's target d [nv] (the hull's signed
  * distance) on the undeformed grid: the template the pretraining tends
  * to, about the size of a fitted one, from which train_steps' calibration
- * starts stage 2 without training the shape network first. */
+ * starts stage 2 without training the shape network first. Like
+ * dyno_template_extract it leaves the grid it contoured in f->v and its
+ * values in f->sdf (stage 2 reads both). */
 int dyno_template_extract_target(dyno_template_fit *f, const float *d, tcb_mt_surface *out, tcb_error *err);
 
 #endif
