@@ -1,7 +1,7 @@
 """PyTorch peer of bench_train_step's dynosurf row: one step of DynoSurf's
-stage 2 (tests/pytorch/dynosurf_torch.py's pieces, as
-tests/pytorch/dynosurf_motion_check.py assembles them; the reference's
-code/loss.py calc_joint_loss): every frame's template carried by the
+stage 2 (tests/pytorch/dynosurf_torch.py's motion_terms, the loss
+tests/pytorch/dynosurf_motion_check.py holds the C step to; the
+reference's code/loss.py calc_joint_loss): every frame's template carried by the
 control-point deformer, surface samples of each (pytorch3d's
 sample_points_from_meshes: faces by area, uniform barycentrics), the robust
 Chamfer and normal terms both ways, the keyframe's identity, the SDF-sign
@@ -34,18 +34,6 @@ import torch_peer
 torch, ds = torch_peer.import_reference("dynosurf_torch")
 
 K = 30  # control points (methods/dynosurf/deformer.h)
-WEIGHTS = {"chamfer": 500, "normal": 0.001, "identity": 1, "sdf_sign": 100, "smooth": 1000}
-
-
-def robust_way(a, na, b, nb):
-    """calc_robust_chamfer_single_direction: sum of w(d^2) d^2 (w detached) and
-    the mean of 1 - |cos| over a's nearest points in b."""
-    with torch.no_grad():
-        j = torch.cdist(a, b).argmin(1)
-    s = ((a - b[j]) ** 2).sum(1)
-    w = torch.exp(-s.detach() ** 2 / (2 * 0.3 ** 2))
-    cos = torch.nn.functional.cosine_similarity(na, nb[j], dim=1, eps=1e-6)
-    return (w * s).sum(), (1 - cos.abs()).mean()
 
 
 def draw(verts, faces, n):
@@ -75,31 +63,14 @@ def main():
     blend_net, b_lin = ds.mlp(params[blend_offset:], ds.BLEND_WIDTHS, 0)
     leaves = [control] + [l.weight for l in t_lin + b_lin]
     opt = torch.optim.Adam(leaves, lr=1e-4)
-    nbrs = [sorted([min(t + 1, F - 1), max(t - 1, 0)]) for t in range(F)]
+    draws = lambda t, X: draw(X, tf, samples)
 
     def step():
         opt.zero_grad()
         pick = torch.randperm(grid_v.shape[0])[:picks]
-        y, yhat = grid_v[pick], grid_sdf[pick]
-        raw, R = ds.deformer_transforms(control, transform_net, list(range(F)))
-        wt, wg = ds.deformer_weights(control, blend_net, tv), ds.deformer_weights(control, blend_net, y)
-        X = torch.stack([ds.deform(tv, wt, R[t], raw[t]) for t in range(F)])
-        Y = torch.stack([ds.deform(y, wg, R[t], raw[t]) for t in range(F)])
-        cham = normal = 0
-        for t in range(F):
-            xs, nxs = ds.sample_points(X[t], tf, *draw(X[t], tf, samples))
-            c1, n1 = robust_way(xs, nxs, pts[t], nrm[t])
-            c2, n2 = robust_way(pts[t], nrm[t], xs, nxs)
-            cham, normal = cham + (c1 + c2) / F, normal + (n1 + n2) / F
-        identity = (raw[key] ** 2).sum()
-        s = torch.stack([ds.approx_sdf(Y[t], pts[t], nrm[t], search=torch.float32) for t in range(F)])
-        rho = torch.softmax(-s.detach() ** 2 / (2 * 0.1 ** 2), 0)
-        sdf_sign = (rho * torch.sigmoid(100 * yhat)[None] - rho * torch.sigmoid(100 * s)).abs().mean()
-        D = torch.stack([X[u] - X[t] for t in range(F) for u in nbrs[t]])
-        smooth = sum(((D[:, tf[:, a]] - D[:, tf[:, b]]) ** 2).sum() for a, b in ((0, 1), (1, 2), (0, 2))) / (3 * len(tf))
-        terms = {"chamfer": cham, "normal": normal, "identity": identity, "sdf_sign": sdf_sign, "smooth": smooth}
-        total = sum(WEIGHTS[k] * v for k, v in terms.items())
-        total.backward()
+        terms = ds.motion_terms(control, transform_net, blend_net, tv, tf, pts, nrm, grid_v[pick], grid_sdf[pick],
+                                key, draws, search=torch.float32)
+        sum(ds.MOTION_WEIGHTS[k] * v for k, v in terms.items()).backward()
         opt.step()
 
     torch_peer.time_steps(step, 1, iters)

@@ -24,8 +24,8 @@ import numpy as np
 import torch
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from dynosurf_torch import (BLEND_WIDTHS, TRANSFORM_WIDTHS, approx_sdf, deform,  # noqa: E402
-                            deformer_transforms, deformer_weights, mlp, sample_points)
+from dynosurf_torch import (BLEND_WIDTHS, MOTION_WEIGHTS, TRANSFORM_WIDTHS, mlp,  # noqa: E402
+                            motion_terms)
 
 binary, work = sys.argv[1], sys.argv[2]
 subprocess.run([binary, "5", work], check=True)
@@ -55,39 +55,10 @@ pts, nrm = f64("pts.bin", (F, n, 3)), f64("nrm.bin", (F, n, 3))
 y, yhat = f64("y.bin", (g, 3)), f64("yhat.bin", (g,))
 draw_face, draw_w = load("draw_face.bin", (F, ms), np.int32).long(), f64("draw_w.bin", (F, ms, 3))
 
-raw, R = deformer_transforms(control, transform_net, list(range(F)))
-wt, wg = deformer_weights(control, blend_net, tv), deformer_weights(control, blend_net, y)
-X = torch.stack([deform(tv, wt, R[t], raw[t]) for t in range(F)])
-Y = torch.stack([deform(y, wg, R[t], raw[t]) for t in range(F)])
-
-
-def robust_way(a, na, b, nb):
-    """calc_robust_chamfer_single_direction: Σ w(d²) d², w detached, and the mean of 1 − |cos|."""
-    d2 = torch.cdist(a.detach(), b.detach()) ** 2
-    j = d2.argmin(1)
-    s = ((a - b[j]) ** 2).sum(1)
-    w = torch.exp(-s.detach() ** 2 / (2 * 0.3 ** 2))
-    cos = torch.nn.functional.cosine_similarity(na, nb[j], dim=1, eps=1e-6)
-    return (w * s).sum(), (1 - cos.abs()).mean()
-
-
-cham = normal = 0
-for t in range(F):
-    xs, nxs = sample_points(X[t], tf, draw_face[t], draw_w[t])
-    c1, n1 = robust_way(xs, nxs, pts[t], nrm[t])
-    c2, n2 = robust_way(pts[t], nrm[t], xs, nxs)
-    cham, normal = cham + (c1 + c2) / F, normal + (n1 + n2) / F
-identity = (raw[key] ** 2).sum()
-s = torch.stack([approx_sdf(Y[t], pts[t], nrm[t]) for t in range(F)])
-rho = torch.softmax(-s.detach() ** 2 / (2 * 0.1 ** 2), 0)
-sdf_sign = (rho * torch.sigmoid(100 * yhat)[None] - rho * torch.sigmoid(100 * s)).abs().mean()
-nbrs = [sorted([min(t + 1, F - 1), max(t - 1, 0)]) for t in range(F)]
-D = torch.stack([X[u] - X[t] for t in range(F) for u in nbrs[t]])
-smooth = sum(((D[:, tf[:, a]] - D[:, tf[:, b]]) ** 2).sum() for a, b in ((0, 1), (1, 2), (0, 2))) / (3 * nf)
-terms = {"chamfer": 500 * cham, "normal": 0.001 * normal, "identity": identity, "sdf_sign": 100 * sdf_sign,
-         "smooth": 1000 * smooth}
+values = motion_terms(control, transform_net, blend_net, tv, tf, pts, nrm, y, yhat, key,
+                      lambda t, X: (draw_face[t], draw_w[t]))
+terms = {name: MOTION_WEIGHTS[name] * v for name, v in values.items()}
 leaves = [control] + [l.weight for l in t_lin + b_lin]
-ours_by_term = {}
 for name, term in terms.items():  # each term's gradient alone: a small term's error would hide in the sum's
     grads = torch.autograd.grad(term, leaves, retain_graph=True, allow_unused=True)
     theirs = torch.cat([(gr if gr is not None else torch.zeros_like(l)).reshape(-1) for gr, l in zip(grads, leaves)])
@@ -97,8 +68,7 @@ for name, term in terms.items():  # each term's gradient alone: a small term's e
             close(f"{name} gradient, {block}", mine[lo:hi], theirs[lo:hi], 1e-3)
 total = sum(terms.values())
 total.backward()
-for name, value in (("chamfer", cham), ("normal", normal), ("identity", identity), ("sdf_sign", sdf_sign),
-                    ("smooth", smooth), ("total", total)):
+for name, value in list(values.items()) + [("total", total)]:
     close(name, meta[name], value.item())
 grad = torch.cat([control.grad.reshape(-1)] + [l.weight.grad.reshape(-1) for l in t_lin + b_lin])
 ours = f64("grad.bin", (P,))

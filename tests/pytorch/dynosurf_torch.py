@@ -180,3 +180,44 @@ def deform(x, w, R, raw):
 def gaussian_weights(control, x, sigma=0.1):
     d2 = ((x[:, None, :] - control[None]) ** 2).sum(-1)
     return torch.softmax(-d2 / (2 * sigma * sigma), -1)
+
+
+MOTION_WEIGHTS = {"chamfer": 500, "normal": 0.001, "identity": 1, "sdf_sign": 100, "smooth": 1000}
+
+
+def robust_way(a, na, b, nb):
+    """calc_robust_chamfer_single_direction: Σ w(d²) d² over a's nearest
+    points in b (w the Welsch weight, detached) and the mean of 1 − |cos|."""
+    with torch.no_grad():
+        j = torch.cdist(a, b).argmin(1)
+    s = ((a - b[j]) ** 2).sum(1)
+    w = torch.exp(-s.detach() ** 2 / (2 * 0.3 ** 2))
+    cos = torch.nn.functional.cosine_similarity(na, nb[j], dim=1, eps=1e-6)
+    return (w * s).sum(), (1 - cos.abs()).mean()
+
+
+def motion_terms(control, transform_net, blend_net, tv, tf, pts, nrm, y, yhat, key, draw, search=torch.float64):
+    """Stage 2's five terms, unweighted (code/loss.py calc_joint_loss; the
+    weights are MOTION_WEIGHTS): the template tv, tf carried into every
+    frame of pts, nrm; draw(t, X_t) gives frame t's surface draws (face
+    indices, barycentric weights); the grid picks y with their SDF yhat;
+    the approximate SDF's neighbours searched in `search`."""
+    F = len(pts)
+    raw, R = deformer_transforms(control, transform_net, list(range(F)))
+    wt, wg = deformer_weights(control, blend_net, tv), deformer_weights(control, blend_net, y)
+    X = torch.stack([deform(tv, wt, R[t], raw[t]) for t in range(F)])
+    Y = torch.stack([deform(y, wg, R[t], raw[t]) for t in range(F)])
+    cham = normal = 0
+    for t in range(F):
+        xs, nxs = sample_points(X[t], tf, *draw(t, X[t]))
+        c1, n1 = robust_way(xs, nxs, pts[t], nrm[t])
+        c2, n2 = robust_way(pts[t], nrm[t], xs, nxs)
+        cham, normal = cham + (c1 + c2) / F, normal + (n1 + n2) / F
+    identity = (raw[key] ** 2).sum()
+    s = torch.stack([approx_sdf(Y[t], pts[t], nrm[t], search=search) for t in range(F)]).to(Y.dtype)
+    rho = torch.softmax(-s.detach() ** 2 / (2 * 0.1 ** 2), 0)
+    sdf_sign = (rho * torch.sigmoid(100 * yhat)[None] - rho * torch.sigmoid(100 * s)).abs().mean()
+    nbrs = [sorted([min(t + 1, F - 1), max(t - 1, 0)]) for t in range(F)]
+    D = torch.stack([X[u] - X[t] for t in range(F) for u in nbrs[t]])
+    smooth = sum(((D[:, tf[:, a]] - D[:, tf[:, b]]) ** 2).sum() for a, b in ((0, 1), (1, 2), (0, 2))) / (3 * len(tf))
+    return {"chamfer": cham, "normal": normal, "identity": identity, "sdf_sign": sdf_sign, "smooth": smooth}
