@@ -241,6 +241,9 @@ int tcb_cell_lock_acquire(tcb_cell_lock *l, const char *cell_path, double timeou
     unlink(tmp);
     if (rc || !claimed) return rc;
     l->held = 1;
+    /* A claimant killed between its temporary and the link left that
+     * temporary; a live one's keeps its pid and stays. */
+    tcb_remove_stale_temps_of(l->path);
     clear_progress(l->path);
     pthread_mutex_init(&l->mu, NULL);
     pthread_cond_init(&l->cv, NULL);

@@ -40,9 +40,12 @@ if [ "$done_at_kill" -lt 3 ] || [ "$done_at_kill" -ge $n_cells ]; then
     echo "FAIL: killed with $done_at_kill of $n_cells cells done (expected a partial run)"
     cat killed.log; exit 1
 fi
-# What a kill during an atomic write leaves behind, on a cell still to do.
+# What a kill during an atomic write leaves behind, on a cell still to do:
+# the cell's temporary, its lock's (a claim killed before its link), the
+# config's.
 mkdir -p killed/cells/synth/quadruped_trot/slow
-touch killed/cells/synth/quadruped_trot/slow/seed_1.json.tmp-Ab12Cd killed/config.json.tmp-Xy34Zw
+touch killed/cells/synth/quadruped_trot/slow/seed_1.json.tmp-Ab12Cd \
+      killed/cells/synth/quadruped_trot/slow/seed_1.json.lock.tmp-Ef56Gh killed/config.json.tmp-Xy34Zw
 "$TCBENCH" run grid.json --out killed --quiet 2> resume.log
 grep -qF "$((n_cells - done_at_kill)) computed, $done_at_kill already done" resume.log ||
     { cat resume.log; exit 1; }
