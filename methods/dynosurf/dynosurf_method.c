@@ -35,6 +35,7 @@
 #include "methods/dynosurf/train.h"
 #include "methods/params.h"
 #include "methods/pcgrid/method.h"
+#include "methods/step_cost.h"
 #include "neural/approx_sdf.h"
 #include "tcb/json.h"
 #include "tcb/meshing.h"
@@ -228,6 +229,12 @@ static cJSON *manifest(const void *self, size_t n_params)
 
 static void main_phase(void *trainer) { dyno_trainer_main_phase(trainer); }
 
+/* The units tcbench calibrate times besides stage 2's step: the grid (the
+ * inputs and problem a fit builds first), then a step of each phase before
+ * stage 2, named as the phases. */
+static const char *const units[] = {"grid", "pretrain", "template", "blend", NULL};
+static int run_unit(void *trainer, int unit, tcb_error *err) { return dyno_trainer_unit_step(trainer, unit - 1, err); }
+
 static const tcb_pcgrid_hooks hooks = {
     .name = "dynosurf", .magic = "TCBDYNM1",
     .problem_size = sizeof(problem), .trainer_size = sizeof(dyno_trainer),
@@ -236,19 +243,55 @@ static const tcb_pcgrid_hooks hooks = {
     .step = step, .done = done, .save = save, .load = load,
     .params = params, .frames = frames, .manifest = manifest,
     .frame_map = dyno_frame_map, .keyframe = dyno_keyframe, .trained_template = trained_template,
-    .describe = describe, .main_phase = main_phase,
+    .describe = describe, .main_phase = main_phase, .run_unit = run_unit,
 };
 
-/* train_steps times stage 2 (dyno_trainer_main_phase), for
- * bench_train_step. No estimate yet: the four phases' steps cost
- * differently, and only stage 2's grows with the frames
- * (docs/protocol.md, "DynoSurf"). */
+/* ---- the dry run's estimate ---- */
+
+/* The calibrated preset of m's sizes (its steps are counted, not
+ * measured); -1 when they differ from each. */
+static int calibrated_preset(const dynosurf_method *m)
+{
+    for (int k = 0; preset_names[k]; k++) {
+        const dyno_preset *p = &presets[k];
+        if (m->base.points == p->points && m->sched.samples == p->samples &&
+            m->sched.grid_samples == p->grid_samples && m->tet_volume == p->tet_volume && m->remesh == p->remesh &&
+            m->base.recon_points == TCB_PCGRID_RECON_POINTS)
+            return k;
+    }
+    return -1;
+}
+
+/* Stage 2's steps priced by train_steps' step (dyno_trainer_main_phase),
+ * the grid and the other phases' steps by their units. A stage-2 step
+ * visits every frame but costs about the same over 6 frames as over 24
+ * (the blend network over the template's vertices and the grid's picks
+ * dominates it: 2.1 and 1.8 s a step on the calibration sequence's walk at
+ * `cpu`, docs/protocol.md), so the frames do not scale it; nor do the
+ * sequence's vertices scale anything: the grid's size follows from the
+ * hull's volume in the normalised frame. */
+static void estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out)
+{
+    (void)q;
+    const dynosurf_method *m = self;
+    const long long *steps = m->sched.steps;
+    int k = calibrated_preset(m);
+    tcb_step_cost_estimate(hooks.name, preset_names, k, steps[DYNO_PHASE_MOTION], out);
+    if (k < 0) return;
+    out->units[out->n_units++] = (tcb_unit_use){"grid", 1, 0, 0, 0};
+    out->units[out->n_units++] = (tcb_unit_use){"pretrain", (double)steps[DYNO_PHASE_PRETRAIN], 0, 0, 0};
+    out->units[out->n_units++] = (tcb_unit_use){"template", (double)steps[DYNO_PHASE_TEMPLATE], 0, 0, 0};
+    out->units[out->n_units++] = (tcb_unit_use){"blend", (double)steps[DYNO_PHASE_BLEND], 0, 0, 0};
+}
+
 const tcb_method_ops tcb_method_dynosurf = {
     .abi_version = TCB_METHOD_ABI_VERSION,
     .name = "dynosurf",
     .description = "DynoSurf (ECCV 2024): an SDF on a tetrahedral grid around the keyframe's hull, extracted by "
                    "marching tetrahedra and carried by 30 learned control points; barycentric read-out",
     .create = create,
+    .estimate = estimate,
+    .presets = preset_names,
     .fit = tcb_pcgrid_fit,
     .transfer = tcb_pcgrid_transfer_op,
     .reconstruct = tcb_pcgrid_reconstruct_op,
@@ -257,5 +300,7 @@ const tcb_method_ops tcb_method_dynosurf = {
     .destroy = tcb_pcgrid_destroy,
     .surface = tcb_pcgrid_surface_op,
     .train_steps = tcb_pcgrid_train_steps,
+    .units = units,
+    .run_unit = tcb_pcgrid_run_unit,
     .normals = tcb_pcgrid_normals_used,
 };

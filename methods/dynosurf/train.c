@@ -173,6 +173,71 @@ int dyno_train_step(dyno_trainer *t, double *loss, tcb_error *err)
     return TCB_OK;
 }
 
+/* The rate of the pretraining that readies stage 1's unit: at the
+ * reference's 1e-4 the SDF takes 200 steps to cross zero at `cpu`'s grid,
+ * at 1e-2 about 40 (measured on the calibration sequence). */
+#define UNIT_PRETRAIN_LR 1e-2
+
+static long long phase_start(const dyno_schedule *s, int phase)
+{
+    long long at = 0;
+    for (int k = 0; k < phase; k++) at += s->steps[k];
+    return at;
+}
+
+/* The faces of the shape network's zero set now. */
+static int network_faces(dyno_trainer *t, int *faces, tcb_error *err)
+{
+    tcb_mt_surface now = {0};
+    int rc = dyno_template_extract(&t->tfit, &t->shape, &now, err);
+    *faces = now.n_faces;
+    tcb_mt_surface_free(&now);
+    return rc;
+}
+
+/* Stage 1's steps cost what a fit's do once the network's zero set is a
+ * surface of a fit's size: a network short of 90 % of the faces of the
+ * hull's zero set (the pretraining's target) is pretrained first, at
+ * UNIT_PRETRAIN_LR, ten steps at a time, for at most the pretraining's
+ * steps. */
+static int ready_stage1(dyno_trainer *t, tcb_error *err)
+{
+    tcb_mt_surface target = {0};
+    int rc = dyno_template_extract_target(&t->tfit, t->p->hull_sd, &target, err), faces = 0;
+    int want = (int)(0.9 * target.n_faces);
+    tcb_mt_surface_free(&target);
+    if (!rc) rc = network_faces(t, &faces, err);
+    double lr = t->s.lr;
+    t->s.lr = UNIT_PRETRAIN_LR;
+    t->it = 0;
+    for (long long k = 0; !rc && faces < want && k < t->s.steps[DYNO_PHASE_PRETRAIN]; k++) {
+        double loss;
+        rc = dyno_train_step(t, &loss, err);
+        if (!rc && (k + 1) % 10 == 0) rc = network_faces(t, &faces, err);
+    }
+    t->s.lr = lr;
+    if (!rc && faces < want)
+        rc = tcb_fail(err, TCB_ERR_NUMERIC, "dynosurf: %lld pretraining steps at %g left the template %d faces, "
+                      "short of the hull's %d", t->s.steps[DYNO_PHASE_PRETRAIN], UNIT_PRETRAIN_LR, faces, want);
+    return rc;
+}
+
+int dyno_trainer_unit_step(dyno_trainer *t, int phase, tcb_error *err)
+{
+    if (phase < 0 || phase >= DYNO_PHASE_MOTION || t->s.steps[phase] < 1)
+        return tcb_fail(err, TCB_ERR_INTERNAL, "dynosurf: no unit of phase %d", phase);
+    long long start = phase_start(&t->s, phase), at;
+    int rc = TCB_OK;
+    if (dyno_phase_of(&t->s, t->it, &at) != phase) {
+        if (phase == DYNO_PHASE_TEMPLATE) rc = ready_stage1(t, err);
+        t->it = start;
+    }
+    double loss;
+    if (!rc) rc = dyno_train_step(t, &loss, err);
+    if (!rc && t->it == start + t->s.steps[phase]) t->it = start; /* the next starts it over */
+    return rc;
+}
+
 int dyno_trainer_template(dyno_trainer *t, const tcb_mt_surface **out, tcb_error *err)
 {
     int rc = prepare_motion(t, err);

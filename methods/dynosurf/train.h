@@ -95,6 +95,13 @@ int dyno_phase_of(const dyno_schedule *s, long long it, long long *start);
  * stage-2 step costs on a template of that size. */
 void dyno_trainer_main_phase(dyno_trainer *t);
 
+/* tcbench calibrate's units: one step of `phase` (pretrain, template or
+ * blend; stage 2 is train_steps'), the trainer moved to the phase's start
+ * when not in it and back there at its end. Stage 1's needs a network
+ * whose zero set is a surface: a trainer without one is pretrained first
+ * (at a larger rate than the reference's, to reach it in fewer steps). */
+int dyno_trainer_unit_step(dyno_trainer *t, int phase, tcb_error *err);
+
 /* One iteration of whichever phase it is in. */
 int dyno_train_step(dyno_trainer *t, double *loss, tcb_error *err);
 

@@ -164,6 +164,7 @@ static void release_model(tcb_pcgrid_method *b)
 struct tcb_pcgrid_steps {
     tcb_pcgrid_inputs in;
     trainer t;
+    int in_main_phase; /* 0 after a unit of hooks->run_unit moved the trainer */
 };
 
 static void steps_free(tcb_pcgrid_method *b)
@@ -305,28 +306,42 @@ int tcb_pcgrid_load(void *self, const tcb_sequence *seq, const char *path, tcb_e
 
 /* ---- calibration ---- */
 
-/* tcb_method_ops.train_steps: fit's training (its inputs and template
- * built by the first call; in its main phase) n epochs at a time; the fitted model follows
- * from the epochs done when a read-out first asks (steps_model), so that
- * the timed calls are epochs only. */
+/* train_steps' training, started by the first call of train_steps or of
+ * a unit of the method's own (the inputs and template a fit builds first). */
+static int steps_start(tcb_pcgrid_method *b, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_error *err)
+{
+    if (b->steps) return TCB_OK;
+    release_model(b);
+    b->seed = ctx->seed;
+    if (!(b->steps = calloc(1, sizeof *b->steps)))
+        return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", b->hooks->name);
+    int rc = prepare(b, seq, ctx->seed, &b->fitted, &b->steps->in, err);
+    if (!rc) rc = trainer_init(b, &b->steps->in, ctx->seed, &b->steps->t, err);
+    if (rc) steps_free(b);
+    return rc;
+}
+
+/* The model of fewer epochs than a fit's is dropped after each timed call:
+ * a read-out rebuilds it (steps_model), so that the timed calls are steps
+ * only. */
+static void drop_model(tcb_pcgrid_method *b)
+{
+    free(b->fitted.deformed), free(b->params);
+    b->fitted.deformed = NULL, b->params = NULL;
+}
+
+/* tcb_method_ops.train_steps: fit's training n epochs at a time, in its
+ * main phase (hooks->main_phase, again after a unit moved the trainer). */
 int tcb_pcgrid_train_steps(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, long long n, tcb_error *err)
 {
     tcb_pcgrid_method *b = self;
-    int rc = TCB_OK;
-    if (!b->steps) {
-        release_model(b);
-        b->seed = ctx->seed;
-        if (!(b->steps = calloc(1, sizeof *b->steps)))
-            return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", b->hooks->name);
-        rc = prepare(b, seq, ctx->seed, &b->fitted, &b->steps->in, err);
-        if (!rc) rc = trainer_init(b, &b->steps->in, ctx->seed, &b->steps->t, err);
-        if (!rc && b->hooks->main_phase) b->hooks->main_phase(b->steps->t.state);
-        if (rc) steps_free(b);
-    }
+    int rc = steps_start(b, seq, ctx, err);
+    if (rc) return rc;
+    if (!b->steps->in_main_phase && b->hooks->main_phase) b->hooks->main_phase(b->steps->t.state);
+    b->steps->in_main_phase = 1;
     double loss;
     for (long long k = 0; !rc && k < n; k++) rc = b->hooks->step(b->steps->t.state, &loss, err);
-    free(b->fitted.deformed), free(b->params);
-    b->fitted.deformed = NULL, b->params = NULL; /* the model of fewer epochs */
+    drop_model(b);
     return rc;
 }
 
@@ -340,11 +355,20 @@ const tcb_pcgrid_inputs *tcb_pcgrid_steps_inputs(const void *self, const void **
 /* tcb_method_ops.run_unit: "template", the inputs and template mesh a fit
  * (and a load) builds before its first epoch: the clouds, the keyframe,
  * its template and the method's problem. Built aside, so that a training
- * of train_steps keeps its own. */
+ * of train_steps keeps its own. A later unit is the method's own
+ * (hooks->run_unit), on train_steps' trainer. */
 int tcb_pcgrid_run_unit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, int unit, tcb_error *err)
 {
     tcb_pcgrid_method *b = self;
-    if (unit != UNIT_TEMPLATE) return tcb_fail(err, TCB_ERR_INTERNAL, "%s: no unit %d", b->hooks->name, unit);
+    if (unit != UNIT_TEMPLATE) {
+        if (!b->hooks->run_unit) return tcb_fail(err, TCB_ERR_INTERNAL, "%s: no unit %d", b->hooks->name, unit);
+        int rc = steps_start(b, seq, ctx, err);
+        if (rc) return rc;
+        b->steps->in_main_phase = 0;
+        rc = b->hooks->run_unit(b->steps->t.state, unit, err);
+        drop_model(b);
+        return rc;
+    }
     tcb_pcgrid_fitted aside = {.method = b->hooks->name};
     tcb_pcgrid_inputs in;
     int rc = prepare(b, seq, ctx->seed, &aside, &in, err);

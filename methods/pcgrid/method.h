@@ -83,6 +83,11 @@ typedef struct tcb_pcgrid_hooks {
     /* Optional (NULL: nothing). One line on the problem a fit is about to
      * train (its sizes), which fit logs at info level. */
     void (*describe)(const void *problem, char *line, size_t size);
+    /* Optional (NULL: "template" is the method's one unit). One run of
+     * the method's unit past "template" (its ops' units[unit], unit >= 1)
+     * on train_steps' trainer, which the next train_steps call puts back
+     * into its main phase. */
+    int (*run_unit)(void *trainer, int unit, tcb_error *err);
 } tcb_pcgrid_hooks;
 
 enum { TCB_PCGRID_NORMALS_ESTIMATED, TCB_PCGRID_NORMALS_GT, TCB_PCGRID_NORMALS_INPUT };

@@ -6,7 +6,7 @@
 # the model from its file (the parameters; the grid and template from the
 # sequence and the seed) and recomputes the pair exactly; a training killed
 # after a checkpoint resumes and ends with the same cell; bad params are
-# refused naming the key.
+# refused naming the key; calibrate and the dry run price it.
 set -euo pipefail
 : "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
 source "$TCB_SOURCE_DIR/tests/integration/cells.sh"
@@ -33,6 +33,26 @@ grep -q "agree: largest relative difference 0.0e+00" inspect.txt || { cat inspec
 
 kill_mid_fit dynosurf.json "$work" "$cell"
 same_cells full killed
+
+# The dry run's price: calibrate times stage 2's step (train_steps) and
+# the grid and the other phases' steps as units (stage 1's after readying
+# a surface), and the estimate counts each phase's steps.
+mkdir -p priced
+expect 0 "wrote priced/calibration.json" "$TCBENCH" calibrate --only dynosurf --preset tiny --threads 1 --budget 4 \
+    --quick --samples 500 --out priced/calibration.json
+/usr/bin/python3 - <<'PY'
+import json
+c = json.load(open("priced/calibration.json"))
+got = {(e["kind"], e.get("unit", "")) for e in c["costs"] if e["method"] == "dynosurf"}
+want = {("step", ""), ("eval_pair", ""), ("unit", "grid"), ("unit", "pretrain"), ("unit", "template"), ("unit", "blend")}
+assert want <= got, got
+assert all(e["seconds"] > 0 for e in c["costs"]), c["costs"]
+PY
+expect 0 "15 steps x" "$TCBENCH" run dynosurf.json --dry-run --out priced
+grep -qE "^ +0 +dynosurf .* 15 steps x [0-9.]+ ms \(1 thread, .*\) \+ [0-9]+ [a-z]+ x " out.txt ||
+    { echo "FAIL: the dry run does not price stage 2's steps and the units"; cat out.txt; exit 1; }
+sed 's/"checkpoint_every": 20/"checkpoint_every": 20, "samples": 401/' dynosurf.json > unpriced.json
+expect 0 "a size differs from every preset" "$TCBENCH" run unpriced.json --dry-run --out priced
 
 bad() { sed "s/\"preset\": \"tiny\", \"checkpoint_every\": 20/$1/" dynosurf.json > bad.json; expect 2 "$2" "$TCBENCH" run bad.json --out bad --quiet; }
 bad '"preset": "huge"' "dynosurf.params.preset"

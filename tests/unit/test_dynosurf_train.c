@@ -208,12 +208,57 @@ static void test_main_phase(void **state)
     dyno_trainer_free(&t);
 }
 
+/* The units of tcbench calibrate: each steps its own phase's parameters
+ * and stays in its phase past the phase's end (over its steps, the
+ * optimiser started over); stage 1's, from a trainer in stage 2 that never
+ * pretrained, is first given a network whose zero set is a surface of at
+ * least 90 % of the hull's faces. */
+static void test_unit_steps(void **state)
+{
+    (void)state;
+    dyno_schedule s = schedule();
+    dyno_trainer t;
+    tcb_error err = {0};
+    assert_int_equal(dyno_trainer_init(&t, &fx->p, &s, 7, &err), TCB_OK);
+    dyno_trainer_main_phase(&t);
+    const int blocks[3][3] = {{1, 0, 0}, {1, 0, 0}, {0, 0, 1}}; /* shape, control + MLP_T, MLP_W */
+    float *before = malloc(t.n_params * sizeof *before);
+    const int phases[2] = {DYNO_PHASE_TEMPLATE, DYNO_PHASE_PRETRAIN}; /* stage 1's first: never pretrained */
+    for (int q = 0; q < 2; q++) {
+        int phase = phases[q];
+        for (long long k = 0; k < s.steps[phase] + 3; k++) {
+            memcpy(before, t.params, t.n_params * sizeof *before);
+            assert_int_equal(dyno_trainer_unit_step(&t, phase, &err), TCB_OK);
+            long long start;
+            assert_int_equal(dyno_phase_of(&s, t.it, &start), phase);
+            int m[3];
+            moved(&t, before, m);
+            for (int b = 0; b < 3; b++) assert_int_equal(m[b], blocks[phase][b]);
+        }
+        if (phase != DYNO_PHASE_TEMPLATE) continue;
+        tcb_mt_surface net = {0}, hull = {0};
+        assert_int_equal(dyno_template_extract(&t.tfit, &t.shape, &net, &err), TCB_OK);
+        assert_int_equal(dyno_template_extract_target(&t.tfit, fx->sd, &hull, &err), TCB_OK);
+        assert_true(net.n_faces >= 0.9 * hull.n_faces);
+        tcb_mt_surface_free(&net), tcb_mt_surface_free(&hull);
+    }
+    memcpy(before, t.params, t.n_params * sizeof *before);
+    assert_int_equal(dyno_trainer_unit_step(&t, DYNO_PHASE_BLEND, &err), TCB_OK);
+    int m[3];
+    moved(&t, before, m);
+    for (int b = 0; b < 3; b++) assert_int_equal(m[b], blocks[DYNO_PHASE_BLEND][b]);
+    assert_int_equal(dyno_trainer_unit_step(&t, DYNO_PHASE_MOTION, &err), TCB_ERR_INTERNAL);
+    free(before);
+    dyno_trainer_free(&t);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_phases),
         cmocka_unit_test(test_resume),
         cmocka_unit_test(test_main_phase),
+        cmocka_unit_test(test_unit_steps),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
