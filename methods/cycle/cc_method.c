@@ -73,6 +73,7 @@ typedef struct cc_method {
     tcb_sequence steps_seq;     /* its view of the sequence (train_view) */
     tcb_cc_frame_box *boxes;    /* [n_frames] of the fitted sequence */
     int n_frames;
+    struct cc_pair_buffers *pair; /* transfer's, kept from pair to pair; NULL: none yet */
 } cc_method;
 
 static int parse_numbers(const cJSON *j, const char *where, const cc_preset *pr, cc_method *c, tcb_error *err)
@@ -135,10 +136,61 @@ static int create(const char *params_json, void **self, tcb_error *err)
     return tcb_method_create(sizeof(cc_method), "cc", params_json, parse_params, NULL, self, err);
 }
 
+/* ---- transfer's buffers ---- */
+
+/* What a pair's transfer computes in: the two clouds, an encoder's and
+ * the deformation's activations and scratch, of the sizes of the last
+ * pair. Kept from pair to pair because buffers this large, allocated
+ * afresh, come from mmap above glibc's threshold and are page-faulted
+ * anew each pair: a `tiny` pair cost 18 ms so against 1.8 ms kept
+ * (measured under tcbench calibrate, whose allocations had not raised
+ * glibc's threshold). */
+typedef struct cc_pair_buffers {
+    int n_enc, n_def;            /* the clouds' points, the transferred points */
+    float *pi, *pj;              /* [n_enc][3] */
+    float *z;                    /* [2][Z] the source's and the target's codes */
+    tcb_cc_encoder_cache ec;
+    tcb_cc_deform_cache dc;
+    float *enc_scratch, *def_scratch;
+} cc_pair_buffers;
+
+static void pair_buffers_free(cc_method *c)
+{
+    cc_pair_buffers *b = c->pair;
+    if (!b) return;
+    if (b->n_enc) tcb_cc_encoder_cache_free(&b->ec);
+    if (b->n_def) tcb_cc_deform_cache_free(&b->dc);
+    free(b->pi), free(b->pj), free(b->z), free(b->enc_scratch), free(b->def_scratch);
+    free(b);
+    c->pair = NULL;
+}
+
+/* c->pair for clouds of n_enc points and n_def points to transfer,
+ * allocated when its sizes differ. */
+static int pair_buffers(cc_method *c, int n_enc, int n_def, tcb_error *err)
+{
+    if (c->pair && c->pair->n_enc == n_enc && c->pair->n_def == n_def) return TCB_OK;
+    pair_buffers_free(c);
+    cc_pair_buffers *b = c->pair = calloc(1, sizeof *b);
+    if (!b) return tcb_fail(err, TCB_ERR_NOMEM, "cc: out of memory");
+    b->pi = malloc((size_t)n_enc * 3 * sizeof *b->pi), b->pj = malloc((size_t)n_enc * 3 * sizeof *b->pj);
+    b->z = malloc(2 * (size_t)c->d.Z * sizeof *b->z);
+    b->enc_scratch = malloc(tcb_cc_encoder_scratch_floats(&c->d, 1, n_enc) * sizeof(float));
+    b->def_scratch = malloc(tcb_cc_deform_scratch_floats(c->net, 1, n_def) * sizeof(float));
+    int rc = b->pi && b->pj && b->z && b->enc_scratch && b->def_scratch
+                 ? TCB_OK
+                 : tcb_fail(err, TCB_ERR_NOMEM, "cc: out of memory");
+    if (!rc && !(rc = tcb_cc_encoder_cache_alloc(&b->ec, &c->d, 1, n_enc, err))) b->n_enc = n_enc;
+    if (!rc && !(rc = tcb_cc_deform_cache_alloc(&b->dc, c->net, 1, n_def, err))) b->n_def = n_def;
+    if (rc) pair_buffers_free(c);
+    return rc;
+}
+
 static void destroy(void *self)
 {
     cc_method *c = self;
     if (!c) return;
+    pair_buffers_free(c);
     tcb_cc_trainer_free(c->steps);
     tcb_cc_net_free(c->net);
     free(c->boxes);
@@ -151,6 +203,7 @@ static int new_net(cc_method *c, const tcb_sequence *seq, uint64_t seed, int ini
 {
     tcb_cc_trainer_free(c->steps); /* it trains the net freed here */
     c->steps = NULL;
+    pair_buffers_free(c); /* sized by the net */
     tcb_cc_net_free(c->net), free(c->boxes);
     c->net = NULL, c->boxes = NULL, c->seed = seed, c->n_frames = seq->n_frames;
     int rc = tcb_cc_net_create(&c->d, &c->net, err);
@@ -225,50 +278,24 @@ static int fit(void *self, const tcb_sequence *seq, const tcb_fit_ctx *ctx, tcb_
 
 /* ---- transfer ---- */
 
-/* The code of encoder e for n points pts [n][3] (in their frame box), in
- * evaluation mode, into z [Z]. */
-static int encode(const cc_method *c, int e, const float *pts, int n, float *z, tcb_error *err)
+/* The code of encoder e for the cloud pts [n][3] (in its frame box, n
+ * the pair buffers' n_enc), in evaluation mode, into z [Z]. */
+static void encode(const cc_method *c, int e, const float *pts, float *z)
 {
-    tcb_cc_encoder_cache ec;
-    float *scratch = malloc(tcb_cc_encoder_scratch_floats(&c->d, 1, n) * sizeof(float));
-    int rc = scratch ? tcb_cc_encoder_cache_alloc(&ec, &c->d, 1, n, err)
-                     : tcb_fail(err, TCB_ERR_NOMEM, "cc: out of memory");
-    if (!rc) {
-        tcb_cc_encoder_forward(&c->net->p.enc[e], &ec, scratch, pts, 0);
-        memcpy(z, ec.z, (size_t)c->d.Z * sizeof(float));
-        tcb_cc_encoder_cache_free(&ec);
-    }
-    free(scratch);
-    return rc;
+    cc_pair_buffers *b = c->pair;
+    tcb_cc_encoder_forward(&c->net->p.enc[e], &b->ec, b->enc_scratch, pts, 0);
+    memcpy(z, b->ec.z, (size_t)c->d.Z * sizeof(float));
 }
 
-/* The encoders' input for frame f: a fresh cloud from rng, or the frame's
- * vertices; in f's box. *pts is malloc'ed [*n][3]. */
-static int encoder_input(const cc_method *c, const tcb_sequence *seq, int f, tcb_rng *rng, float **pts, int *n,
+/* The encoders' input for frame f into pts [n][3]: a fresh cloud from rng,
+ * or the frame's vertices; in f's box. */
+static int encoder_input(const cc_method *c, const tcb_sequence *seq, int f, tcb_rng *rng, float *pts, int n,
                          tcb_error *err)
 {
-    *n = c->readout_vertices ? seq->n_verts : seq->input_points;
-    if (!(*pts = malloc((size_t)*n * 3 * sizeof **pts))) return tcb_fail(err, TCB_ERR_NOMEM, "cc: out of memory");
     int rc = TCB_OK;
-    if (c->readout_vertices) memcpy(*pts, tcb_seq_frame(seq, f), (size_t)*n * 3 * sizeof **pts);
-    else rc = tcb_sequence_draw_points(seq, f, *n, seq->draw_with_replacement, rng, *pts, err);
-    if (!rc) tcb_cc_frame_box_apply(&c->boxes[f], *pts, *n, *pts);
-    return rc;
-}
-
-static int deform(const cc_method *c, const float *zx, const float *zy, const float *x, int n, float *out,
-                  tcb_error *err)
-{
-    tcb_cc_deform_cache dc;
-    float *scratch = malloc(tcb_cc_deform_scratch_floats(c->net, 1, n) * sizeof(float));
-    int rc = scratch ? tcb_cc_deform_cache_alloc(&dc, c->net, 1, n, err)
-                     : tcb_fail(err, TCB_ERR_NOMEM, "cc: out of memory");
-    if (!rc) {
-        tcb_cc_deform_forward(c->net, &dc, scratch, zx, zy, x, 0);
-        memcpy(out, dc.out, (size_t)n * 3 * sizeof(float));
-        tcb_cc_deform_cache_free(&dc);
-    }
-    free(scratch);
+    if (c->readout_vertices) memcpy(pts, tcb_seq_frame(seq, f), (size_t)n * 3 * sizeof *pts);
+    else rc = tcb_sequence_draw_points(seq, f, n, seq->draw_with_replacement, rng, pts, err);
+    if (!rc) tcb_cc_frame_box_apply(&c->boxes[f], pts, n, pts);
     return rc;
 }
 
@@ -280,19 +307,19 @@ static int transfer(void *self, const tcb_sequence *seq, int i, int j, const flo
     if (i < 0 || j < 0 || i >= seq->n_frames || j >= seq->n_frames || seq->n_frames != c->n_frames)
         return tcb_fail(err, TCB_ERR_INPUT, "cc: pair %d->%d outside frames 0..%d of the fitted sequence", i, j,
                         c->n_frames - 1);
-    float *pi = NULL, *pj = NULL, *z = malloc(2 * (size_t)c->d.Z * sizeof *z);
-    int ni, nj, rc = z ? TCB_OK : tcb_fail(err, TCB_ERR_NOMEM, "cc: out of memory");
-    if (!rc) rc = encoder_input(c, seq, i, rng, &pi, &ni, err);
-    if (!rc) rc = encoder_input(c, seq, j, rng, &pj, &nj, err);
-    if (!rc) rc = encode(c, 0, pi, ni, z, err);
-    if (!rc) rc = encode(c, 1, pj, nj, z + c->d.Z, err);
-    if (!rc) {
-        tcb_cc_frame_box_apply(&c->boxes[i], src, n, out);
-        rc = deform(c, z, z + c->d.Z, out, n, out, err);
-    }
-    if (!rc) tcb_cc_frame_box_invert(&c->boxes[j], out, n, out);
-    free(pi), free(pj), free(z);
-    return rc;
+    int n_enc = c->readout_vertices ? seq->n_verts : seq->input_points;
+    int rc = pair_buffers(c, n_enc, n, err);
+    if (!rc) rc = encoder_input(c, seq, i, rng, c->pair->pi, n_enc, err);
+    if (!rc) rc = encoder_input(c, seq, j, rng, c->pair->pj, n_enc, err);
+    if (rc) return rc;
+    cc_pair_buffers *b = c->pair;
+    encode(c, 0, b->pi, b->z);
+    encode(c, 1, b->pj, b->z + c->d.Z);
+    tcb_cc_frame_box_apply(&c->boxes[i], src, n, out);
+    tcb_cc_deform_forward(c->net, &b->dc, b->def_scratch, b->z, b->z + c->d.Z, out, 0);
+    memcpy(out, b->dc.out, (size_t)n * 3 * sizeof(float));
+    tcb_cc_frame_box_invert(&c->boxes[j], out, n, out);
+    return TCB_OK;
 }
 
 /* ---- checkpoint: one model file (neural/weights.h), magic "TCBCCMD1" ---- */

@@ -264,10 +264,10 @@ static int calibrated_preset(const dynosurf_method *m)
 
 /* Stage 2's steps priced by train_steps' step (dyno_trainer_main_phase),
  * the grid and the other phases' steps by their units. A stage-2 step
- * visits every frame but costs about the same over 6 frames as over 24
+ * visits every frame but costs about the same over 6 frames as over 48
  * (the blend network over the template's vertices and the grid's picks
- * dominates it: 2.1 and 1.8 s a step on the calibration sequence's walk at
- * `cpu`, docs/protocol.md), so the frames do not scale it; nor do the
+ * dominates it: 1.9 and 2.0 s a step on the synthetic walk at `cpu`,
+ * docs/protocol.md), so the frames do not scale it; nor do the
  * sequence's vertices scale anything: the grid's size follows from the
  * hull's volume in the normalised frame. */
 static void estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out)

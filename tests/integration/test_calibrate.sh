@@ -132,14 +132,15 @@ expect 2 "run/calibration.json: costs[0].threads" "$TCBENCH" run small.json --dr
 # The built-in calibration prices every trained method's every preset at 1
 # and 2 threads (the issue's evidence shows the paper table's trained cells
 # priced; here every preset of the built-in trained methods, neupig's fast
-# by paper's step), the atlas family's reconstruction metrics, and nricp's
-# four strategies from its units.
+# by paper's step, dynosurf's by its step and units), the atlas family's
+# reconstruction metrics, and nricp's four strategies from its units.
 rm run/calibration.json
 /usr/bin/python3 - <<'PY'
 import json
 methods = [{"name": f"{m}_{p}", "method": m, "params": {"preset": p}}
            for m, presets in (("atlasnet", "paper cpu tiny"), ("dsr", "paper cpu tiny"), ("mca", "paper cpu tiny"),
-                              ("cc", "paper cpu short tiny"), ("neupig", "paper fast cpu tiny"))
+                              ("cc", "paper cpu short tiny"), ("neupig", "paper fast cpu tiny"),
+                              ("dynosurf", "paper cpu tiny"))
            for p in presets.split()]
 methods += [{"name": f"nricp_{s}", "method": "nricp", "params": {"strategy": s}}
             for s in ("random", "propagate_simple", "propagate_bijective", "propagate_deform")]
@@ -150,8 +151,8 @@ for t in (1, 2):
                "methods": methods}, open(f"b{t}.json", "w"))
 PY
 for t in 1 2; do
-    expect 0 "cells: 21, 0 finished, 21 to run" "$TCBENCH" run b$t.json --dry-run
-    [ "$(grep -cE "^ +[0-9]+ .* steps x [0-9.]+ ms( at its frames)? \($t threads?, " out.txt)" -eq 17 ] &&
+    expect 0 "cells: 24, 0 finished, 24 to run" "$TCBENCH" run b$t.json --dry-run
+    [ "$(grep -cE "^ +[0-9]+ .* steps x [0-9.]+ ms( at its frames)? \($t threads?, " out.txt)" -eq 20 ] &&
         [ "$(grep -cE "^ +[0-9]+ +nricp_.* (register_[a-z]+|assign) x [0-9.e+-]+ s \(1 thread, " out.txt)" -eq 4 ] &&
         ! grep -qE " \? |not measured" out.txt ||
         { echo "FAIL: a cost the built-in calibration does not price at $t threads (calibration/default.json made"
