@@ -2,6 +2,7 @@
 #include "methods/dynosurf/motion.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -30,11 +31,13 @@ int dyno_motion_fit_init(dyno_motion_fit *f, const dyno_motion_data *data, tcb_e
     f->s = malloc(F * g * sizeof(float)), f->ds = malloc(F * g * sizeof(float));
     f->nbr = malloc(F * g * TCB_APPROX_SDF_K * sizeof(int32_t));
     f->draws = malloc(F * ms * sizeof *f->draws);
-    f->xs = malloc(ms * 3 * sizeof(float)), f->nxs = malloc(ms * 3 * sizeof(float));
-    f->dxs = malloc(ms * 3 * sizeof(float)), f->dnxs = malloc(ms * 3 * sizeof(float));
-    f->face_grad = malloc((size_t)d->n_faces * 3 * sizeof(float));
+    size_t th = (size_t)(f->n_scratch = omp_get_max_threads());
+    f->xs = malloc(th * ms * 3 * sizeof(float)), f->nxs = malloc(th * ms * 3 * sizeof(float));
+    f->dxs = malloc(th * ms * 3 * sizeof(float)), f->dnxs = malloc(th * ms * 3 * sizeof(float));
+    f->face_grad = malloc(th * (size_t)d->n_faces * 3 * sizeof(float));
+    f->frame_cd = malloc(F * sizeof(double)), f->frame_normal = malloc(F * sizeof(double));
     int ok = f->frames && f->perm && f->X && f->dX && f->y && f->yhat && f->Y && f->dY && f->s && f->ds && f->nbr &&
-             f->draws && f->xs && f->nxs && f->dxs && f->dnxs && f->face_grad;
+             f->draws && f->xs && f->nxs && f->dxs && f->dnxs && f->face_grad && f->frame_cd && f->frame_normal;
     int rc = ok ? dyno_blend_alloc(&f->bt, d->n_template, err)
                 : tcb_fail(err, TCB_ERR_NOMEM, "dynosurf: out of memory for stage 2 over %d frames", d->n_frames);
     if (!rc) rc = dyno_blend_alloc(&f->bg, d->n_grid_samples, err);
@@ -52,7 +55,7 @@ void dyno_motion_fit_free(dyno_motion_fit *f)
     dyno_blend_free(&f->bt), dyno_blend_free(&f->bg), dyno_transforms_free(&f->tr);
     free(f->frames), free(f->perm), free(f->X), free(f->dX), free(f->y), free(f->yhat), free(f->Y), free(f->dY);
     free(f->s), free(f->ds), free(f->nbr), free(f->draws), free(f->xs), free(f->nxs), free(f->dxs), free(f->dnxs);
-    free(f->face_grad);
+    free(f->face_grad), free(f->frame_cd), free(f->frame_normal);
     memset(f, 0, sizeof *f);
 }
 
@@ -80,6 +83,7 @@ static void deform_all(dyno_motion_fit *f, const dyno_deformer *dfm)
     dyno_blend_forward(dfm, &f->bt, d->template_verts, d->n_template);
     dyno_blend_forward(dfm, &f->bg, f->y, d->n_grid_samples);
     dyno_transforms_forward(dfm, &f->tr, f->frames, d->n_frames);
+#pragma omp parallel for schedule(static)
     for (int t = 0; t < d->n_frames; t++) {
         const float *R = f->tr.R + 9 * K * t, *raw = f->tr.raw + 6 * K * t;
         dyno_deform_apply(d->template_verts, d->n_template, f->bt.w, R, raw, f->X + 3 * m * t);
@@ -87,29 +91,52 @@ static void deform_all(dyno_motion_fit *f, const dyno_deformer *dfm)
     }
 }
 
+/* Frame u's robust Chamfer and normal terms from its drawn samples, their
+ * gradient (weighted by wc, wn) into f->dX, with thread th's scratch. */
+static int chamfer_frame(dyno_motion_fit *f, int u, int th, float wc, float wn, tcb_error *err)
+{
+    const dyno_motion_data *d = &f->data;
+    size_t m = (size_t)d->n_template, ms = (size_t)d->n_samples, at = (size_t)th * ms * 3;
+    const float *X = f->X + 3 * m * u;
+    const tcb_mesh_draw *draws = f->draws + ms * u;
+    float *xs = f->xs + at, *nxs = f->nxs + at, *dxs = f->dxs + at, *dnxs = f->dnxs + at;
+    tcb_mesh_sample_forward(X, d->faces, draws, (int)ms, xs, nxs);
+    int rc = tcb_robust_chamfer_normals(xs, nxs, (int)ms, d->pts[u], d->normals[u], d->n_pts[u], d->index[u],
+                                        TCB_ROBUST_CHAMFER_ALPHA, &f->frame_cd[u], &f->frame_normal[u], dxs, dnxs,
+                                        err);
+    if (rc) return rc;
+    for (size_t i = 0; i < 3 * ms; i++) dxs[i] *= wc, dnxs[i] *= wn;
+    tcb_mesh_sample_backward(X, d->faces, d->n_faces, draws, (int)ms, dxs, dnxs,
+                             f->face_grad + (size_t)th * d->n_faces * 3, f->dX + 3 * m * u);
+    return TCB_OK;
+}
+
 /* The robust Chamfer and normal terms, means over frames; their gradient
- * (weighted) into f->dX through the samples. */
+ * (weighted) into f->dX through the samples. Every frame's samples are
+ * drawn first, in frame order from the one stream; the frames then go
+ * side by side, and their terms are summed in frame order, so the result
+ * does not depend on the threads. */
 static int chamfer_terms(dyno_motion_fit *f, struct tcb_rng *rng, dyno_motion_terms *t, tcb_error *err)
 {
     const dyno_motion_data *d = &f->data;
     size_t m = (size_t)d->n_template;
-    int ms = d->n_samples;
-    float wc = (float)(d->weights.chamfer / d->n_frames), wn = (float)(d->weights.normal / d->n_frames);
-    for (int u = 0; u < d->n_frames; u++) {
-        const float *X = f->X + 3 * m * u;
-        tcb_mesh_draw *draws = f->draws + (size_t)ms * u;
-        int rc = tcb_mesh_sample_draw(X, d->faces, d->n_faces, ms, rng, draws, err);
+    int ms = d->n_samples, F = d->n_frames, failed = 0;
+    float wc = (float)(d->weights.chamfer / F), wn = (float)(d->weights.normal / F);
+    for (int u = 0; u < F; u++) {
+        int rc = tcb_mesh_sample_draw(f->X + 3 * m * u, d->faces, d->n_faces, ms, rng, f->draws + (size_t)ms * u, err);
         if (rc) return rc;
-        tcb_mesh_sample_forward(X, d->faces, draws, ms, f->xs, f->nxs);
-        double cd, normal;
-        rc = tcb_robust_chamfer_normals(f->xs, f->nxs, ms, d->pts[u], d->normals[u], d->n_pts[u], d->index[u],
-                                        TCB_ROBUST_CHAMFER_ALPHA, &cd, &normal, f->dxs, f->dnxs, err);
-        if (rc) return rc;
-        t->chamfer += cd / d->n_frames, t->normal += normal / d->n_frames;
-        for (size_t i = 0; i < 3 * (size_t)ms; i++) f->dxs[i] *= wc, f->dnxs[i] *= wn;
-        tcb_mesh_sample_backward(X, d->faces, d->n_faces, draws, ms, f->dxs, f->dnxs, f->face_grad,
-                                 f->dX + 3 * m * u);
     }
+#pragma omp parallel for schedule(dynamic) num_threads(f->n_scratch)
+    for (int u = 0; u < F; u++) {
+        tcb_error mine = {0};
+        int rc = chamfer_frame(f, u, omp_get_thread_num(), wc, wn, &mine);
+        if (rc) {
+#pragma omp critical(dyno_chamfer_failure)
+            if (!failed) failed = rc, *err = mine;
+        }
+    }
+    if (failed) return failed;
+    for (int u = 0; u < F; u++) t->chamfer += f->frame_cd[u] / F, t->normal += f->frame_normal[u] / F;
     return TCB_OK;
 }
 
@@ -132,13 +159,19 @@ static double sigmoid(double z) { return 1 / (1 + exp(-z)); }
 static int sdf_sign_term(dyno_motion_fit *f, double *value, tcb_error *err)
 {
     const dyno_motion_data *d = &f->data;
-    int F = d->n_frames, g = d->n_grid_samples;
+    int F = d->n_frames, g = d->n_grid_samples, failed = 0;
+#pragma omp parallel for schedule(dynamic)
     for (int u = 0; u < F; u++) {
+        tcb_error mine = {0};
         int rc = tcb_approx_sdf_forward(f->s + (size_t)g * u, f->nbr + (size_t)g * u * TCB_APPROX_SDF_K,
                                         f->Y + 3 * (size_t)g * u, g, d->index[u], d->pts[u], d->normals[u],
-                                        TCB_APPROX_SDF_K, TCB_APPROX_SDF_RADIUS, err);
-        if (rc) return rc;
+                                        TCB_APPROX_SDF_K, TCB_APPROX_SDF_RADIUS, &mine);
+        if (rc) {
+#pragma omp critical(dyno_sdf_failure)
+            if (!failed) failed = rc, *err = mine;
+        }
     }
+    if (failed) return failed;
     const double scale = 1.0 / (2 * DYNO_FUSION_THRES * DYNO_FUSION_THRES), mean = 1.0 / ((double)F * g);
     double sum = 0, *rho = malloc((size_t)F * sizeof *rho);
     if (!rho) return tcb_fail(err, TCB_ERR_NOMEM, "dynosurf: out of memory");
@@ -160,6 +193,7 @@ static int sdf_sign_term(dyno_motion_fit *f, double *value, tcb_error *err)
     }
     free(rho);
     *value = sum;
+#pragma omp parallel for schedule(dynamic)
     for (int u = 0; u < F; u++)
         tcb_approx_sdf_backward(f->dY + 3 * (size_t)g * u, f->ds + (size_t)g * u, f->Y + 3 * (size_t)g * u, g,
                                 f->nbr + (size_t)g * u * TCB_APPROX_SDF_K, d->pts[u], d->normals[u], TCB_APPROX_SDF_K,

@@ -74,8 +74,10 @@ typedef struct dyno_motion_fit {
     float *s, *ds;           /* [F][g] */
     int32_t *nbr;            /* [F][g][TCB_APPROX_SDF_K] */
     tcb_mesh_draw *draws;    /* [F][n_samples]: this step's surface samples */
-    float *xs, *nxs, *dxs, *dnxs; /* samples, normals and their gradients [n_samples][3] */
-    float *face_grad;        /* [n_faces][3] */
+    int n_scratch;           /* the threads that take frames side by side, one scratch each */
+    float *xs, *nxs, *dxs, *dnxs; /* per thread: samples, normals and their gradients [n_samples][3] */
+    float *face_grad;        /* per thread: [n_faces][3] */
+    double *frame_cd, *frame_normal; /* [F]: each frame's terms, summed in frame order */
 } dyno_motion_fit;
 
 int dyno_motion_fit_init(dyno_motion_fit *f, const dyno_motion_data *data, tcb_error *err);
