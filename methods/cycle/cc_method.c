@@ -142,7 +142,7 @@ static int create(const char *params_json, void **self, tcb_error *err)
  * the deformation's activations and scratch, of the sizes of the last
  * pair. Kept from pair to pair because buffers this large, allocated
  * afresh, come from mmap above glibc's threshold and are page-faulted
- * anew each pair: a `tiny` pair cost 18 ms so against 1.8 ms kept
+ * anew each pair: a `tiny` pair cost 18 ms that way against 1.8 ms kept
  * (measured under tcbench calibrate, whose allocations had not raised
  * glibc's threshold). */
 typedef struct cc_pair_buffers {

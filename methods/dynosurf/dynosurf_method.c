@@ -231,9 +231,10 @@ static void main_phase(void *trainer) { dyno_trainer_main_phase(trainer); }
 
 /* The units tcbench calibrate times besides stage 2's step: the grid (the
  * inputs and problem a fit builds first), then a step of each phase before
- * stage 2, named as the phases. */
+ * stage 2, named as the phases: unit 1 + p is phase p's step. */
 static const char *const units[] = {"grid", "pretrain", "template", "blend", NULL};
 static int run_unit(void *trainer, int unit, tcb_error *err) { return dyno_trainer_unit_step(trainer, unit - 1, err); }
+_Static_assert(sizeof units / sizeof *units - 1 <= TCB_MAX_UNIT_USES, "the estimate counts every unit");
 
 static const tcb_pcgrid_hooks hooks = {
     .name = "dynosurf", .magic = "TCBDYNM1",
@@ -278,10 +279,11 @@ static void estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out
     int k = calibrated_preset(m);
     tcb_step_cost_estimate(hooks.name, preset_names, k, steps[DYNO_PHASE_MOTION], out);
     if (k < 0) return;
-    out->units[out->n_units++] = (tcb_unit_use){"grid", 1, 0, 0, 0};
-    out->units[out->n_units++] = (tcb_unit_use){"pretrain", (double)steps[DYNO_PHASE_PRETRAIN], 0, 0, 0};
-    out->units[out->n_units++] = (tcb_unit_use){"template", (double)steps[DYNO_PHASE_TEMPLATE], 0, 0, 0};
-    out->units[out->n_units++] = (tcb_unit_use){"blend", (double)steps[DYNO_PHASE_BLEND], 0, 0, 0};
+    for (int u = 0; units[u]; u++) {
+        tcb_unit_use *use = &out->units[out->n_units++];
+        *use = (tcb_unit_use){.fit = u == 0 ? 1 : (double)steps[u - 1]};
+        snprintf(use->unit, sizeof use->unit, "%s", units[u]);
+    }
 }
 
 const tcb_method_ops tcb_method_dynosurf = {
