@@ -45,11 +45,12 @@ extern "C" {
  * estimate priced by calibrated costs (tcb_cost_estimate.steps, .preset),
  * 6 `units`, `run_unit`, the estimate's unit counts (.units, .n_units) and
  * steps that grow with the frame count (.step_frames), 7 `version`, 8
- * `normals` and the sequence's input normals (tcb_sequence.input_normals); tables
- * of older versions still load, and the harness reads no member their
- * version did not have (their tables end before it; the estimate it
- * zeroes). */
-#define TCB_METHOD_ABI_VERSION 8
+ * `normals` and the sequence's input normals (tcb_sequence.input_normals),
+ * 9 eight unit counts in the estimate (TCB_MAX_UNIT_USES, four before);
+ * tables of older versions still load, and the harness reads no member
+ * their version did not have (their tables end before it; the estimate it
+ * zeroes, and an older table fills at most its version's unit slots). */
+#define TCB_METHOD_ABI_VERSION 9
 #define TCB_METHOD_ABI_OLDEST 1
 
 typedef struct tcb_fit_ctx {
@@ -105,7 +106,9 @@ typedef struct tcb_unit_use {
                              * divides its counts by its threads itself) */
 } tcb_unit_use;
 
-#define TCB_MAX_UNIT_USES 4
+/* Unit counts an estimate holds: 8 from abi_version 9, 4 before (a
+ * table of an older version never fills more). */
+#define TCB_MAX_UNIT_USES 8
 
 typedef struct tcb_cost_estimate {
     double fit_s, eval_s;

@@ -230,11 +230,20 @@ static cJSON *manifest(const void *self, size_t n_params)
 static void main_phase(void *trainer) { dyno_trainer_main_phase(trainer); }
 
 /* The units tcbench calibrate times besides stage 2's step: the grid (the
- * inputs and problem a fit builds first), then a step of each phase before
- * stage 2, named as the phases: unit 1 + p is phase p's step. */
-static const char *const units[] = {"grid", "pretrain", "template", "blend", NULL};
-static int run_unit(void *trainer, int unit, tcb_error *err) { return dyno_trainer_unit_step(trainer, unit - 1, err); }
-_Static_assert(sizeof units / sizeof *units - 1 <= TCB_MAX_UNIT_USES, "the estimate counts every unit");
+ * inputs and problem a fit builds first), a step of each phase before
+ * stage 2, named as the phases (unit 1 + p is phase p's step), and what
+ * each frame adds to a stage-2 step. */
+enum { UNIT_GRID, UNIT_PRETRAIN, UNIT_TEMPLATE, UNIT_BLEND, UNIT_FRAME, N_UNITS };
+static const char *const units[] = {"grid", "pretrain", "template", "blend", "frame", NULL};
+_Static_assert(sizeof units / sizeof *units - 1 == N_UNITS, "a name per unit");
+_Static_assert(N_UNITS <= TCB_MAX_UNIT_USES, "the estimate counts every unit");
+_Static_assert(UNIT_BLEND - UNIT_PRETRAIN == DYNO_PHASE_BLEND - DYNO_PHASE_PRETRAIN, "a unit per phase before stage 2");
+
+static int run_unit(void *trainer, int unit, tcb_error *err)
+{
+    return unit == UNIT_FRAME ? dyno_trainer_frame_unit(trainer, err)
+                              : dyno_trainer_unit_step(trainer, unit - UNIT_PRETRAIN + DYNO_PHASE_PRETRAIN, err);
+}
 
 static const tcb_pcgrid_hooks hooks = {
     .name = "dynosurf", .magic = "TCBDYNM1",
@@ -263,25 +272,40 @@ static int calibrated_preset(const dynosurf_method *m)
     return -1;
 }
 
-/* Stage 2's steps priced by train_steps' step (dyno_trainer_main_phase),
- * the grid and the other phases' steps by their units. A stage-2 step
- * visits every frame but costs about the same over 6 frames as over 48
- * (the blend network over the template's vertices and the grid's picks
- * dominates it: 1.9 and 2.0 s a step on the synthetic walk at `cpu`,
- * docs/protocol.md), so the frames do not scale it; nor do the
- * sequence's vertices scale anything: the grid's size follows from the
+/* Stage 2's steps priced by train_steps' step (dyno_trainer_main_phase)
+ * plus, for each, its frames' terms by the `frame` unit; the grid and
+ * the other phases' steps by their units. train_steps' step is mostly the
+ * blend network over the template's vertices and the grid's picks, which
+ * the frames do not change; the terms of the calibration sequence's 6
+ * frames in it are counted again by the frame units (about 5 % of a step
+ * at `paper`, docs/protocol.md). The frames of a step run side by side,
+ * one a thread: the frame unit is priced at one thread, its count over
+ * the cell's threads. The
+ * sequence's vertices scale nothing: the grid's size follows from the
  * hull's volume in the normalised frame. */
 static void estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out)
 {
-    (void)q;
     const dynosurf_method *m = self;
     const long long *steps = m->sched.steps;
     int k = calibrated_preset(m);
     tcb_step_cost_estimate(hooks.name, preset_names, k, steps[DYNO_PHASE_MOTION], out);
     if (k < 0) return;
-    for (int u = 0; units[u]; u++) {
+    if (q->n_frames < 1) {
+        *out = (tcb_cost_estimate){.fit_s = -1, .eval_s = -1};
+        snprintf(out->basis, sizeof out->basis, "grows with the frame count (data absent)");
+        return;
+    }
+    int threads = q->n_threads > 1 ? q->n_threads : 1;
+    const double count[N_UNITS] = {
+        [UNIT_GRID] = 1,
+        [UNIT_PRETRAIN] = (double)steps[DYNO_PHASE_PRETRAIN],
+        [UNIT_TEMPLATE] = (double)steps[DYNO_PHASE_TEMPLATE],
+        [UNIT_BLEND] = (double)steps[DYNO_PHASE_BLEND],
+        [UNIT_FRAME] = (double)steps[DYNO_PHASE_MOTION] * q->n_frames / threads,
+    };
+    for (int u = 0; u < N_UNITS; u++) {
         tcb_unit_use *use = &out->units[out->n_units++];
-        *use = (tcb_unit_use){.fit = u == 0 ? 1 : (double)steps[u - 1]};
+        *use = (tcb_unit_use){.fit = count[u], .threads = u == UNIT_FRAME ? 1 : 0 /* 0: the cell's */};
         snprintf(use->unit, sizeof use->unit, "%s", units[u]);
     }
 }

@@ -75,20 +75,38 @@ static void pick_grid(dyno_motion_fit *f, struct tcb_rng *rng)
     }
 }
 
+/* X_t and Y_t from the blend weights and frame t's transforms. */
+static void deform_frame(dyno_motion_fit *f, int t)
+{
+    const dyno_motion_data *d = &f->data;
+    size_t m = (size_t)d->n_template, g = (size_t)d->n_grid_samples;
+    const float *R = f->tr.R + 9 * K * t, *raw = f->tr.raw + 6 * K * t;
+    dyno_deform_apply(d->template_verts, d->n_template, f->bt.w, R, raw, f->X + 3 * m * t);
+    dyno_deform_apply(f->y, d->n_grid_samples, f->bg.w, R, raw, f->Y + 3 * g * t);
+}
+
+/* dX_t and dY_t back through frame t's deformation: into its transforms'
+ * gradient and, added, the blend weights'. */
+static void deform_frame_backward(dyno_motion_fit *f, int t)
+{
+    const dyno_motion_data *d = &f->data;
+    size_t m = (size_t)d->n_template, g = (size_t)d->n_grid_samples;
+    const float *R = f->tr.R + 9 * K * t, *raw = f->tr.raw + 6 * K * t;
+    float *dR = f->tr.dR + 9 * K * t, *draw = f->tr.draw + 6 * K * t;
+    dyno_deform_apply_backward(d->template_verts, d->n_template, f->bt.w, R, raw, f->dX + 3 * m * t, dR, draw,
+                               f->bt.dw);
+    dyno_deform_apply_backward(f->y, d->n_grid_samples, f->bg.w, R, raw, f->dY + 3 * g * t, dR, draw, f->bg.dw);
+}
+
 /* X and Y of every frame from the current deformer. */
 static void deform_all(dyno_motion_fit *f, const dyno_deformer *dfm)
 {
     const dyno_motion_data *d = &f->data;
-    size_t m = (size_t)d->n_template, g = (size_t)d->n_grid_samples;
     dyno_blend_forward(dfm, &f->bt, d->template_verts, d->n_template);
     dyno_blend_forward(dfm, &f->bg, f->y, d->n_grid_samples);
     dyno_transforms_forward(dfm, &f->tr, f->frames, d->n_frames);
 #pragma omp parallel for schedule(static)
-    for (int t = 0; t < d->n_frames; t++) {
-        const float *R = f->tr.R + 9 * K * t, *raw = f->tr.raw + 6 * K * t;
-        dyno_deform_apply(d->template_verts, d->n_template, f->bt.w, R, raw, f->X + 3 * m * t);
-        dyno_deform_apply(f->y, d->n_grid_samples, f->bg.w, R, raw, f->Y + 3 * g * t);
-    }
+    for (int t = 0; t < d->n_frames; t++) deform_frame(f, t);
 }
 
 /* Frame u's robust Chamfer and normal terms from its drawn samples, their
@@ -155,6 +173,25 @@ static double identity_term(dyno_motion_fit *f)
 
 static double sigmoid(double z) { return 1 / (1 + exp(-z)); }
 
+/* Frame u's approximate SDF s_u at its picks Y_u. */
+static int sdf_frame_forward(dyno_motion_fit *f, int u, tcb_error *err)
+{
+    const dyno_motion_data *d = &f->data;
+    size_t g = (size_t)d->n_grid_samples;
+    return tcb_approx_sdf_forward(f->s + g * u, f->nbr + g * u * TCB_APPROX_SDF_K, f->Y + 3 * g * u, (int)g,
+                                  d->index[u], d->pts[u], d->normals[u], TCB_APPROX_SDF_K, TCB_APPROX_SDF_RADIUS, err);
+}
+
+/* ds_u back through frame u's approximate SDF into dY_u. */
+static void sdf_frame_backward(dyno_motion_fit *f, int u)
+{
+    const dyno_motion_data *d = &f->data;
+    size_t g = (size_t)d->n_grid_samples;
+    tcb_approx_sdf_backward(f->dY + 3 * g * u, f->ds + g * u, f->Y + 3 * g * u, (int)g,
+                            f->nbr + g * u * TCB_APPROX_SDF_K, d->pts[u], d->normals[u], TCB_APPROX_SDF_K,
+                            TCB_APPROX_SDF_RADIUS);
+}
+
 /* The SDF-sign term; its gradient into f->dY. */
 static int sdf_sign_term(dyno_motion_fit *f, double *value, tcb_error *err)
 {
@@ -163,9 +200,7 @@ static int sdf_sign_term(dyno_motion_fit *f, double *value, tcb_error *err)
 #pragma omp parallel for schedule(dynamic)
     for (int u = 0; u < F; u++) {
         tcb_error mine = {0};
-        int rc = tcb_approx_sdf_forward(f->s + (size_t)g * u, f->nbr + (size_t)g * u * TCB_APPROX_SDF_K,
-                                        f->Y + 3 * (size_t)g * u, g, d->index[u], d->pts[u], d->normals[u],
-                                        TCB_APPROX_SDF_K, TCB_APPROX_SDF_RADIUS, &mine);
+        int rc = sdf_frame_forward(f, u, &mine);
         if (rc) {
 #pragma omp critical(dyno_sdf_failure)
             if (!failed) failed = rc, *err = mine;
@@ -194,10 +229,7 @@ static int sdf_sign_term(dyno_motion_fit *f, double *value, tcb_error *err)
     free(rho);
     *value = sum;
 #pragma omp parallel for schedule(dynamic)
-    for (int u = 0; u < F; u++)
-        tcb_approx_sdf_backward(f->dY + 3 * (size_t)g * u, f->ds + (size_t)g * u, f->Y + 3 * (size_t)g * u, g,
-                                f->nbr + (size_t)g * u * TCB_APPROX_SDF_K, d->pts[u], d->normals[u], TCB_APPROX_SDF_K,
-                                TCB_APPROX_SDF_RADIUS);
+    for (int u = 0; u < F; u++) sdf_frame_backward(f, u);
     return TCB_OK;
 }
 
@@ -252,13 +284,7 @@ int dyno_motion_loss(dyno_motion_fit *f, const dyno_deformer *dfm, const dyno_de
     const dyno_motion_weights *w = &d->weights;
     t->total = w->chamfer * t->chamfer + w->normal * t->normal + w->identity * t->identity +
                w->sdf_sign * t->sdf_sign + w->smooth * t->smooth;
-    for (int u = 0; u < F; u++) {
-        const float *R = f->tr.R + 9 * K * u, *raw = f->tr.raw + 6 * K * u;
-        float *dR = f->tr.dR + 9 * K * u, *draw = f->tr.draw + 6 * K * u;
-        dyno_deform_apply_backward(d->template_verts, d->n_template, f->bt.w, R, raw, f->dX + 3 * m * u, dR, draw,
-                                   f->bt.dw);
-        dyno_deform_apply_backward(f->y, d->n_grid_samples, f->bg.w, R, raw, f->dY + 3 * g * u, dR, draw, f->bg.dw);
-    }
+    for (int u = 0; u < F; u++) deform_frame_backward(f, u);
     dyno_transforms_backward(dfm, grad, &f->tr);
     dyno_blend_backward(dfm, grad, &f->bt);
     dyno_blend_backward(dfm, grad, &f->bg);
@@ -275,4 +301,21 @@ void dyno_motion_frames(dyno_motion_fit *f, const dyno_deformer *dfm, float *X)
     for (int t = 0; t < d->n_frames; t++)
         dyno_deform_apply(d->template_verts, d->n_template, f->bt.w, f->tr.R + 9 * K * t, f->tr.raw + 6 * K * t,
                           X + 3 * m * t);
+}
+
+int dyno_motion_frame_cost(dyno_motion_fit *f, struct tcb_rng *rng, int u, tcb_error *err)
+{
+    const dyno_motion_data *d = &f->data;
+    size_t m = (size_t)d->n_template, ms = (size_t)d->n_samples;
+    if (u < 0 || u >= d->n_frames) return tcb_fail(err, TCB_ERR_INTERNAL, "dynosurf: no frame %d", u);
+    deform_frame(f, u);
+    memset(f->dX + 3 * m * u, 0, 3 * m * sizeof(float));
+    int rc = tcb_mesh_sample_draw(f->X + 3 * m * u, d->faces, d->n_faces, (int)ms, rng, f->draws + ms * u, err);
+    if (!rc) rc = chamfer_frame(f, u, 0, (float)(d->weights.chamfer / d->n_frames),
+                                (float)(d->weights.normal / d->n_frames), err);
+    if (!rc) rc = sdf_frame_forward(f, u, err);
+    if (rc) return rc;
+    sdf_frame_backward(f, u);
+    deform_frame_backward(f, u);
+    return TCB_OK;
 }

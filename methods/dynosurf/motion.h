@@ -92,6 +92,15 @@ typedef struct dyno_motion_terms {
 int dyno_motion_loss(dyno_motion_fit *f, const dyno_deformer *d, const dyno_deformer *grad, struct tcb_rng *rng,
                      dyno_motion_terms *t, tcb_error *err);
 
+/* What each frame adds to a step, for the dry run's `frame` unit: frame
+ * u's deformation of the template and the picks, its surface samples
+ * (from rng), robust Chamfer and normal terms, approximate SDF forward and
+ * backward, and its share of the backward through the deformation, on the
+ * blend weights, transforms and picks of the last dyno_motion_loss (which
+ * must have run). It moves no parameter: the next loss recomputes all it
+ * writes. */
+int dyno_motion_frame_cost(dyno_motion_fit *f, struct tcb_rng *rng, int u, tcb_error *err);
+
 /* The template's vertices carried to every frame: X [F][n_template][3]. */
 void dyno_motion_frames(dyno_motion_fit *f, const dyno_deformer *d, float *X);
 

@@ -238,6 +238,17 @@ int dyno_trainer_unit_step(dyno_trainer *t, int phase, tcb_error *err)
     return rc;
 }
 
+int dyno_trainer_frame_unit(dyno_trainer *t, tcb_error *err)
+{
+    int rc = TCB_OK;
+    if (!t->motion_ready) {
+        double loss;
+        dyno_trainer_main_phase(t);
+        rc = dyno_train_step(t, &loss, err);
+    }
+    return rc ? rc : dyno_motion_frame_cost(&t->mfit, &t->rng, 0, err);
+}
+
 int dyno_trainer_template(dyno_trainer *t, const tcb_mt_surface **out, tcb_error *err)
 {
     int rc = prepare_motion(t, err);

@@ -102,6 +102,11 @@ void dyno_trainer_main_phase(dyno_trainer *t);
  * (at a larger rate than the reference's, to reach it in fewer steps). */
 int dyno_trainer_unit_step(dyno_trainer *t, int phase, tcb_error *err);
 
+/* tcbench calibrate's `frame` unit: what one frame adds to a stage-2
+ * step (dyno_motion_frame_cost, frame 0), after a stage-2 step from
+ * dyno_trainer_main_phase when the trainer has taken none. */
+int dyno_trainer_frame_unit(dyno_trainer *t, tcb_error *err);
+
 /* One iteration of whichever phase it is in. */
 int dyno_train_step(dyno_trainer *t, double *loss, tcb_error *err);
 

@@ -34,9 +34,10 @@ grep -q "agree: largest relative difference 0.0e+00" inspect.txt || { cat inspec
 kill_mid_fit dynosurf.json "$work" "$cell"
 same_cells full killed
 
-# The dry run's price: calibrate times stage 2's step (train_steps) and
-# the grid and the other phases' steps as units (stage 1's after readying
-# a surface), and the estimate counts each phase's steps.
+# The dry run's price: calibrate times stage 2's step (train_steps), the
+# grid and the other phases' steps as units (stage 1's after readying a
+# surface) and a frame's share of a stage-2 step, and the estimate counts
+# each phase's steps and stage 2's frames.
 mkdir -p priced
 expect 0 "wrote priced/calibration.json" "$TCBENCH" calibrate --only dynosurf --preset tiny --threads 1 --budget 4 \
     --quick --samples 500 --out priced/calibration.json
@@ -44,7 +45,8 @@ expect 0 "wrote priced/calibration.json" "$TCBENCH" calibrate --only dynosurf --
 import json
 c = json.load(open("priced/calibration.json"))
 got = {(e["kind"], e.get("unit", "")) for e in c["costs"] if e["method"] == "dynosurf"}
-want = {("step", ""), ("eval_pair", ""), ("unit", "grid"), ("unit", "pretrain"), ("unit", "template"), ("unit", "blend")}
+want = {("step", ""), ("eval_pair", ""), ("unit", "grid"), ("unit", "pretrain"), ("unit", "template"), ("unit", "blend"),
+        ("unit", "frame")}
 assert want <= got, got
 assert all(e["seconds"] > 0 for e in c["costs"]), c["costs"]
 PY

@@ -5,7 +5,8 @@
  * pretraining losses fall, the fitted frames are finite and share the
  * template's vertices; a run resumed from a checkpoint in stage 2 (the
  * template extracted again from the loaded weights) ends bit for bit where
- * the unbroken run ends; a checkpoint of another schedule is refused. */
+ * the unbroken run ends; a checkpoint of another schedule is refused;
+ * tcbench calibrate's units and the dry run's estimate that counts them. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -18,6 +19,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "methods/builtin.h"
 #include "methods/dynosurf/grid.h"
 #include "methods/dynosurf/train.h"
 #include "tcb/meshing.h"
@@ -252,6 +254,77 @@ static void test_unit_steps(void **state)
     dyno_trainer_free(&t);
 }
 
+/* The `frame` unit: a fresh trainer first takes a stage-2 step (it needs
+ * the step's blend weights and transforms), then each run redoes frame
+ * 0's terms on them and moves no parameter: its deformation and
+ * approximate SDF, poisoned before, come back to the step's values bit
+ * for bit, and its Chamfer's gradient is finite. */
+static void test_frame_unit(void **state)
+{
+    (void)state;
+    dyno_schedule s = schedule();
+    dyno_trainer t;
+    tcb_error err = {0};
+    assert_int_equal(dyno_trainer_init(&t, &fx->p, &s, 7, &err), TCB_OK);
+    float *before = malloc(t.n_params * sizeof *before);
+    memcpy(before, t.params, t.n_params * sizeof *before);
+    assert_int_equal(dyno_trainer_frame_unit(&t, &err), TCB_OK);
+    int m[3];
+    moved(&t, before, m);
+    assert_int_equal(m[0], 0), assert_int_equal(m[1], 1), assert_int_equal(m[2], 1); /* the stage-2 step */
+    dyno_motion_fit *f = &t.mfit;
+    size_t nx = 3 * (size_t)f->data.n_template, ns = (size_t)f->data.n_grid_samples;
+    float *X0 = malloc(nx * sizeof *X0), *s0 = malloc(ns * sizeof *s0);
+    memcpy(X0, f->X, nx * sizeof *X0), memcpy(s0, f->s, ns * sizeof *s0);
+    for (int run = 0; run < 2; run++) {
+        for (size_t i = 0; i < nx; i++) f->X[i] = f->dX[i] = NAN;
+        for (size_t i = 0; i < ns; i++) f->s[i] = NAN;
+        memcpy(before, t.params, t.n_params * sizeof *before);
+        assert_int_equal(dyno_trainer_frame_unit(&t, &err), TCB_OK);
+        moved(&t, before, m);
+        assert_int_equal(m[0] + m[1] + m[2], 0);
+        assert_memory_equal(f->X, X0, nx * sizeof *X0);
+        assert_memory_equal(f->s, s0, ns * sizeof *s0);
+        for (size_t i = 0; i < nx; i++) assert_true(isfinite(f->dX[i]));
+    }
+    free(X0), free(s0), free(before);
+    dyno_trainer_free(&t);
+}
+
+/* The dry run's estimate: stage 2's steps by train_steps' step, the grid
+ * once, each earlier phase's steps by its unit, and each stage-2 step's
+ * frames by the frame unit over the cell's threads; without the frame
+ * count, no price. */
+static void test_estimate(void **state)
+{
+    (void)state;
+    const tcb_method_ops *ops = &tcb_method_dynosurf;
+    void *self = NULL;
+    tcb_error err = {0};
+    assert_int_equal(ops->create("{\"preset\": \"cpu\"}", &self, &err), TCB_OK);
+    const struct { int frames, threads; double frame_units; } cases[] = {{6, 1, 4800}, {175, 1, 140000}, {175, 2, 70000}};
+    for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
+        tcb_cost_query q = {cases[c].frames, 2688, 500, cases[c].threads};
+        tcb_cost_estimate e = {0};
+        ops->estimate(self, &q, &e);
+        assert_string_equal(e.preset, "cpu");
+        assert_true(e.steps == 800 && e.step_frames == 0 && e.n_units == 5);
+        const char *names[] = {"grid", "pretrain", "template", "blend", "frame"};
+        const double fits[] = {1, 1000, 1500, 1000, cases[c].frame_units};
+        for (int u = 0; u < 5; u++) {
+            assert_string_equal(e.units[u].unit, names[u]);
+            assert_true(e.units[u].fit == fits[u] && e.units[u].eval == 0 && e.units[u].exponent == 0);
+            assert_int_equal(e.units[u].threads, u == 4);
+        }
+    }
+    tcb_cost_query absent = {0, 0, 500, 1};
+    tcb_cost_estimate e = {0};
+    ops->estimate(self, &absent, &e);
+    assert_true(e.fit_s < 0 && e.eval_s < 0 && e.preset[0] == 0 && e.n_units == 0);
+    assert_non_null(strstr(e.basis, "frame count"));
+    ops->destroy(self);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -259,6 +332,8 @@ int main(void)
         cmocka_unit_test(test_resume),
         cmocka_unit_test(test_main_phase),
         cmocka_unit_test(test_unit_steps),
+        cmocka_unit_test(test_frame_unit),
+        cmocka_unit_test(test_estimate),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
