@@ -183,8 +183,11 @@ static int price_units(const tcb_calibration_set *s, const char *method, const t
         char threads[64];
         most = fit + eval;
         threads_text(&p, u->threads > 0 ? u->threads : q->n_threads, threads, sizeof threads);
-        int len = snprintf(costliest, sizeof costliest, "%.4g %.31s x %.3g s", u->fit + u->eval, u->unit,
-                           fit + eval > 0 ? (fit + eval) / (u->fit + u->eval) : 0.0);
+        /* a whole count as a number, not in exponent form: "140000 frame", not "1.4e+05 frame" */
+        double count = u->fit + u->eval;
+        int len = snprintf(costliest, sizeof costliest, count == floor(count) && count < 1e15 ? "%.0f %.31s x %.3g s"
+                                                                                              : "%.4g %.31s x %.3g s",
+                           count, u->unit, fit + eval > 0 ? (fit + eval) / count : 0.0);
         if (!after_steps && len > 0 && (size_t)len < sizeof costliest)
             snprintf(costliest + len, sizeof costliest - (size_t)len, " (%.40s, %.50s)", threads, p.from->machine);
     }

@@ -280,9 +280,8 @@ static int calibrated_preset(const dynosurf_method *m)
  * frames in it are counted again by the frame units (about 5 % of a step
  * at `paper`, docs/protocol.md). The frames of a step run side by side,
  * one a thread: the frame unit is priced at one thread, its count over
- * the cell's threads. The
- * sequence's vertices scale nothing: the grid's size follows from the
- * hull's volume in the normalised frame. */
+ * the cell's threads. The sequence's vertices scale nothing: the grid's
+ * size follows from the hull's volume in the normalised frame. */
 static void estimate(void *self, const tcb_cost_query *q, tcb_cost_estimate *out)
 {
     const dynosurf_method *m = self;

@@ -79,12 +79,24 @@ training() {
     [ -e "$(cell "$1").lock" ] || fail "task $1 did not start"
     sleep 1
 }
+# scancel ARGS, again while slurmctld answers that the job "can not be
+# altered now, try again later" (a task still configuring on a loaded
+# machine); any other error at once.
+signal() {
+    for _ in $(seq 50); do
+        scancel "$@" 2> scancel.err && return 0
+        grep -q "try again later" scancel.err || { cat scancel.err; return 1; }
+        sleep 0.2
+    done
+    cat scancel.err
+    return 1
+}
 training 1
 training 2
-scancel --signal=TERM "${job}_1" || fail "could not signal task 1"
-scancel "${job}_2" || fail "could not cancel task 2"
+signal --signal=TERM "${job}_1" || fail "could not signal task 1"
+signal "${job}_2" || fail "could not cancel task 2"
 training 3
-scancel --batch --signal=USR1 "${job}_3" || fail "could not signal task 3"
+signal --batch --signal=USR1 "${job}_3" || fail "could not signal task 3"
 # Slurm holds a requeued job back (BeginTime: until the old job's
 # credential has expired, 120 s); let it start sooner, but only 2 s after
 # the requeue: slurmd refuses a credential created within the second its
