@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "tcb/json.h"
 #include "tcb/report.h"
@@ -66,16 +67,66 @@ static cJSON *baseline_json(const tcb_rpt *r)
     return root;
 }
 
+/* {metric: {"abs", "rel"}} for the metrics whose tolerances differ from
+ * (base_abs, base_rel), or every metric without a base; added to o as
+ * "tolerances" when there is one. */
+static int add_tolerances(cJSON *o, const double *abs_tol, const double *rel_tol, const double *base_abs,
+                          const double *base_rel)
+{
+    cJSON *t = cJSON_CreateObject();
+    int ok = t != NULL;
+    for (int m = 0; m < TCB_N_METRICS && ok; m++) {
+        if (base_abs && abs_tol[m] == base_abs[m] && rel_tol[m] == base_rel[m]) continue;
+        cJSON *mt = cJSON_AddObjectToObject(t, tcb_rpt_metrics[m].key);
+        ok = mt && cJSON_AddNumberToObject(mt, "abs", abs_tol[m]) && cJSON_AddNumberToObject(mt, "rel", rel_tol[m]);
+    }
+    if (ok && !t->child) {
+        cJSON_Delete(t);
+        return 1;
+    }
+    cJSON_DeleteItemFromObjectCaseSensitive(o, "tolerances");
+    ok = ok && cJSON_AddItemToObject(o, "tolerances", t);
+    if (!ok) cJSON_Delete(t);
+    return ok;
+}
+
+/* The tolerances a person set in the baseline being rewritten: the file's
+ * and each row's own, for the rows the run still has. A rewrite that
+ * dropped them made the trained rows of tests/baselines/quick.json exact
+ * at one thread count. */
+static int keep_tolerances(cJSON *root, const tcb_baseline *old)
+{
+    int ok = add_tolerances(root, old->abs_tol, old->rel_tol, NULL, NULL);
+    for (cJSON *o = cJSON_GetObjectItemCaseSensitive(root, "rows")->child; o && ok; o = o->next) {
+        const char *d = cJSON_GetObjectItemCaseSensitive(o, "dataset")->valuestring,
+                   *s = cJSON_GetObjectItemCaseSensitive(o, "sequence")->valuestring,
+                   *m = cJSON_GetObjectItemCaseSensitive(o, "method")->valuestring;
+        for (int k = 0; k < old->n_rows; k++) {
+            const tcb_baseline_row *r = &old->rows[k];
+            if (!strcmp(r->dataset, d) && !strcmp(r->sequence, s) && !strcmp(r->method, m))
+                ok = add_tolerances(o, r->abs_tol, r->rel_tol, old->abs_tol, old->rel_tol);
+        }
+    }
+    return ok;
+}
+
 int tcb_baseline_write(const char *run_dir, const char *baseline_path, tcb_error *err)
 {
+    tcb_baseline old = {0};
+    int has_old = access(baseline_path, F_OK) == 0;
+    if (has_old && tcb_baseline_load(baseline_path, &old, err)) {
+        tcb_error_prefix(err, "cannot keep the tolerances of the baseline it replaces (remove it to write a new one): ");
+        return err->code;
+    }
     tcb_rpt r;
     int rc = tcb_rpt_load(run_dir, &r, err);
-    if (rc) return rc;
-    cJSON *root = baseline_json(&r);
-    tcb_rpt_free(&r);
-    if (!root) return tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", baseline_path);
-    rc = tcb_json_save(baseline_path, root, err);
+    cJSON *root = rc ? NULL : baseline_json(&r);
+    if (!rc) tcb_rpt_free(&r);
+    if (!rc && (!root || (has_old && !keep_tolerances(root, &old))))
+        rc = tcb_fail(err, TCB_ERR_NOMEM, "%s: out of memory", baseline_path);
+    if (!rc) rc = tcb_json_save(baseline_path, root, err);
     cJSON_Delete(root);
+    tcb_baseline_free(&old);
     return rc;
 }
 

@@ -223,6 +223,63 @@ static void test_row_tolerance(void **state)
         fail_msg("message: %s", err.msg);
 }
 
+/* A wider file tolerance for rank and a row's own for sl2. */
+static void person_tolerances(cJSON *root, cJSON *row)
+{
+    cJSON *rank = cJSON_GetObjectItem(cJSON_GetObjectItem(root, "tolerances"), "rank");
+    cJSON_ReplaceItemInObject(rank, "abs", cJSON_CreateNumber(0.5));
+    cJSON *t = cJSON_AddObjectToObject(row, "tolerances"), *m = cJSON_AddObjectToObject(t, "sl2");
+    cJSON_AddNumberToObject(m, "abs", 2e-3), cJSON_AddNumberToObject(m, "rel", 0.25);
+}
+
+/* --update rewrites the values but keeps the tolerances a person set: the
+ * file's, and a row's own (that row only); a baseline that does not load
+ * is left as it is, with an error naming it. */
+static void test_update_keeps_tolerances(void **state)
+{
+    fixture *f = *state;
+    char path[2048];
+    edited(f, "horse", "AN", person_tolerances, "person.json", path, sizeof path);
+    tcb_error err = {0};
+    assert_int_equal(tcb_baseline_write(f->dir, path, &err), TCB_OK);
+    cJSON *root;
+    assert_int_equal(tcb_json_load(path, &root, &err), TCB_OK);
+    cJSON *tol = cJSON_GetObjectItem(root, "tolerances");
+    assert_true(cJSON_GetObjectItem(cJSON_GetObjectItem(tol, "rank"), "abs")->valuedouble == 0.5);
+    assert_true(cJSON_GetObjectItem(cJSON_GetObjectItem(tol, "sl2"), "abs")->valuedouble == 1e-6);
+    int own = 0;
+    for (cJSON *r = cJSON_GetObjectItem(root, "rows")->child; r; r = r->next) {
+        cJSON *t = cJSON_GetObjectItem(r, "tolerances");
+        if (!t) continue;
+        own++;
+        assert_string_equal(cJSON_GetObjectItem(r, "sequence")->valuestring, "horse");
+        assert_string_equal(cJSON_GetObjectItem(r, "method")->valuestring, "AN");
+        cJSON *sl2 = cJSON_GetObjectItem(t, "sl2");
+        assert_true(cJSON_GetObjectItem(sl2, "abs")->valuedouble == 2e-3);
+        assert_true(cJSON_GetObjectItem(sl2, "rel")->valuedouble == 0.25);
+        assert_int_equal(cJSON_GetArraySize(t), 1);
+    }
+    assert_int_equal(own, 1);
+    cJSON_Delete(root);
+    char *table;
+    assert_int_equal(check(f, path, &table), 0);
+    free(table);
+
+    FILE *bad = fopen(path, "w");
+    assert_non_null(bad);
+    fputs("{\"format\": ", bad);
+    fclose(bad);
+    assert_int_equal(tcb_baseline_write(f->dir, path, &err), TCB_ERR_INPUT);
+    if (!strstr(err.msg, "cannot keep the tolerances") || !strstr(err.msg, "person.json"))
+        fail_msg("message: %s", err.msg);
+    char text[64] = {0};
+    bad = fopen(path, "r");
+    assert_non_null(bad);
+    assert_non_null(fgets(text, sizeof text, bad));
+    fclose(bad);
+    assert_string_equal(text, "{\"format\": ");
+}
+
 static void test_null_and_status_mismatch_drift(void **state)
 {
     fixture *f = *state;
@@ -419,6 +476,7 @@ int main(void)
         cmocka_unit_test(test_drift_beyond_tolerance),
         cmocka_unit_test(test_relative_tolerance),
         cmocka_unit_test(test_row_tolerance),
+        cmocka_unit_test(test_update_keeps_tolerances),
         cmocka_unit_test(test_null_and_status_mismatch_drift),
         cmocka_unit_test(test_rows_not_in_the_baseline_are_listed_not_judged),
         cmocka_unit_test(test_rows_the_run_lacks_drift),
