@@ -12,9 +12,10 @@
 # repeat bit for bit at a given thread count, but another thread count or
 # CPU rounds reductions differently and the training amplifies it, so their
 # rows in the baseline carry wider tolerances than the untrained methods'
-# (the 1- and 2-thread runs both check clean). It runs one thread: beside
-# the other tests on a 2-core machine, two threads' barriers cost a fifth
-# more CPU (238 against 197 s of CPU for the 24 cells).
+# (the 1- and 2-thread runs both check clean). It runs one thread: two
+# cost a fifth more CPU (238 against 197 s for the 24 cells, each run
+# alone), and beside the other tests on a 2-core machine the CPU is what
+# the suite waits for.
 set -euo pipefail
 : "${TCBENCH:?}" "${TCB_SOURCE_DIR:?}"
 if [ -z "${TCBENCH_RELEASE:-}" ]; then
