@@ -1,120 +1,292 @@
-/* Normal-compatible k-NN over tcb_nn: fetch a block of plain nearest
- * candidates, keep the compatible ones in order, and re-query the queries
- * that came up short with a block GROWTH times larger, until the block is
- * the whole cloud. On a surface the nearest candidate is nearly always
- * compatible, so almost every query is settled by the first pass, which for
- * k = 1 is the cheaper tcb_nn_query1. */
+/* Normal-compatible k-NN: a kd-tree over the points whose every node also
+ * bounds its points' normals, so that a search skips a subtree whose normals
+ * all face away from the query's as it skips one that lies too far.
+ *
+ * Written here because no kept library prunes a nearest-neighbour search by
+ * a second attribute: FLANN can only filter candidates after fetching them.
+ * tcbench did that until 2026-12 (a block of plain nearest candidates,
+ * widened 4× until k compatible ones were in it). Between frames far apart —
+ * crane's random pairs — many points' nearest neighbours lie on the far side
+ * of a thin part, the blocks grew to hundreds and FLANN's result set,
+ * O(block) per insertion, took most of a registration (perf: 60 % of a
+ * crane cell in FLANN's search and result sets). Here a query costs about
+ * what a plain one does, however the clouds are posed.
+ *
+ * The tree splits at the median of the widest axis (ties by index, so the
+ * tree depends on the input alone) down to LEAF points. Pruning is
+ * conservative by a margin above float rounding, so the results are those
+ * of an exhaustive scan in the same arithmetic. */
 #include "methods/nricp/knn_compat.h"
 
+#include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
-#define FIRST_BLOCK 8 /* candidates per query in the first k-NN pass (at least 2k) */
-#define GROWTH 4
-/* Cap on queries × block held at once: a cloud whose normals all face away
- * from the queries needs block = n for every query. */
-#define MAX_ENTRIES (1 << 22)
+#define LEAF 16
 
-static inline int compatible(const float *a, const float *b)
+typedef struct node {
+    float lo[3], hi[3];   /* bounds of the points' positions */
+    float nlo[3], nhi[3]; /* bounds of their normals */
+    float nmax;           /* their largest |component| */
+    int begin, end;       /* its points: [begin, end) of the index's order */
+    int left, right;      /* children; -1 for a leaf */
+    int axis;             /* the split: left's points ≤ split ≤ right's along axis as */
+    float split;          /* built; after a move, only which child a search tries first */
+} node;
+
+/* The points in the tree's order, one array per coordinate so that a
+ * leaf's scan runs in vector lanes. */
+struct nricp_compat_index {
+    int n, n_nodes;
+    float *x, *y, *z, *nx, *ny, *nz; /* [n] each, one allocation */
+    int32_t *id;                      /* [n]: the caller's index of each */
+    node *nodes;                      /* nodes[0] is the root */
+};
+
+/* ---- build ------------------------------------------------------------------ */
+
+static int count_nodes(int n) { return n <= LEAF ? 1 : 1 + count_nodes(n / 2) + count_nodes(n - n / 2); }
+
+static inline int key_less(const float *p, int axis, int32_t a, int32_t b)
 {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] >= 0.0f;
+    float x = p[3 * (size_t)a + axis], y = p[3 * (size_t)b + axis];
+    return x < y || (x == y && a < b);
 }
 
-/* Keep the compatible candidates of one sorted row (length block) for query
- * q; returns how many were kept (≤ k). */
-static int filter_row(const float *nrm, const float *qn, const int32_t *ridx, const float *rd2,
-                      int block, int k, int32_t *idx, float *d2)
+/* Reorder v[0..n) so that v[nth] holds the element of that rank by
+ * (coordinate, index) and no smaller one follows it nor larger precedes. */
+static void select_nth(const float *p, int axis, int32_t *v, int n, int nth)
 {
-    int found = 0;
-    for (int a = 0; a < block && found < k; a++) {
-        if (!compatible(qn, nrm + 3 * (size_t)ridx[a])) continue;
-        idx[found] = ridx[a];
-        if (d2) d2[found] = rd2[a];
-        found++;
-    }
-    for (int a = found; a < k; a++) {
-        idx[a] = -1;
-        if (d2) d2[a] = 0.0f;
-    }
-    return found;
-}
-
-/* One pass over the pending queries (ids pend[0..*np)) with `block`
- * candidates each; settled queries are removed from pend. */
-static int pass(const tcb_nn *nn, const float *nrm, const float *qp, const float *qn, int k,
-                int block, int32_t *pend, int *np, int32_t *idx, float *d2, int *cnt,
-                tcb_error *err)
-{
-    int n = tcb_nn_size(nn);
-    int chunk = MAX_ENTRIES / block > 0 ? MAX_ENTRIES / block : 1;
-    if (chunk > *np) chunk = *np;
-    float *buf = malloc((size_t)chunk * 3 * sizeof *buf);
-    int32_t *ridx = malloc((size_t)chunk * block * sizeof *ridx);
-    float *rd2 = malloc((size_t)chunk * block * sizeof *rd2);
-    int rc = buf && ridx && rd2 ? TCB_OK : tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory");
-    int kept = 0;
-    for (int start = 0; !rc && start < *np; start += chunk) {
-        int m = *np - start < chunk ? *np - start : chunk;
-        for (int t = 0; t < m; t++)
-            for (int c = 0; c < 3; c++) buf[3 * t + c] = qp[3 * (size_t)pend[start + t] + c];
-        rc = tcb_nn_queryk(nn, buf, m, block, ridx, rd2, err);
-        for (int t = 0; !rc && t < m; t++) {
-            int32_t q = pend[start + t];
-            int found = filter_row(nrm, qn + 3 * (size_t)q, ridx + (size_t)t * block,
-                                   rd2 + (size_t)t * block, block, k, idx + (size_t)q * k,
-                                   d2 ? d2 + (size_t)q * k : NULL);
-            cnt[q] = found;
-            /* Writes trail reads, so compacting in place is safe. */
-            if (found < k && block < n) pend[kept++] = q;
+    int lo = 0, hi = n - 1;
+    while (hi > lo) {
+        int32_t a = v[lo], b = v[lo + (hi - lo) / 2], c = v[hi], pivot;
+        if (key_less(p, axis, a, b)) pivot = key_less(p, axis, b, c) ? b : key_less(p, axis, a, c) ? c : a;
+        else pivot = key_less(p, axis, a, c) ? a : key_less(p, axis, b, c) ? c : b;
+        int i = lo, j = hi;
+        while (i <= j) {
+            while (key_less(p, axis, v[i], pivot)) i++;
+            while (key_less(p, axis, pivot, v[j])) j--;
+            if (i <= j) {
+                int32_t t = v[i];
+                v[i++] = v[j], v[j--] = t;
+            }
         }
+        if (nth <= j) hi = j;
+        else if (nth >= i) lo = i;
+        else return;
     }
-    *np = kept;
-    free(buf), free(ridx), free(rd2);
-    return rc;
 }
 
-/* k = 1 first pass: the plain nearest neighbour, kept when compatible. */
-static int pass_nearest(const tcb_nn *nn, const float *nrm, const float *qp, const float *qn,
-                        int nq, int32_t *pend, int *np, int32_t *idx, float *d2, int *cnt,
-                        tcb_error *err)
+static void bound(const float *x, const int32_t *ids, int n, float lo[3], float hi[3])
 {
-    float *dist = d2 ? d2 : malloc((size_t)nq * sizeof *dist);
-    if (!dist) return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory");
-    int rc = tcb_nn_query1(nn, qp, nq, idx, dist, err);
-    *np = 0;
-    for (int q = 0; !rc && q < nq; q++) {
-        cnt[q] = compatible(qn + 3 * (size_t)q, nrm + 3 * (size_t)idx[q]);
-        if (!cnt[q]) {
-            idx[q] = -1;
-            dist[q] = 0.0f;
-            pend[(*np)++] = q;
+    for (int c = 0; c < 3; c++) lo[c] = hi[c] = x[3 * (size_t)ids[0] + c];
+    for (int i = 1; i < n; i++)
+        for (int c = 0; c < 3; c++) {
+            float v = x[3 * (size_t)ids[i] + c];
+            lo[c] = v < lo[c] ? v : lo[c];
+            hi[c] = v > hi[c] ? v : hi[c];
         }
-    }
-    if (!d2) free(dist);
-    return rc;
 }
 
-int nricp_knn_compat(const tcb_nn *nn, const float *nrm, const float *qp, const float *qn,
-                     int nq, int k, int32_t *idx, float *d2, int *cnt, tcb_error *err)
+/* Node for ids[begin, end) (the caller's indices), built depth first. */
+static int build_node(nricp_compat_index *ix, const float *pts, const float *nrm, int32_t *ids, int begin,
+                      int end)
 {
-    int n = tcb_nn_size(nn);
+    int self = ix->n_nodes++;
+    node *nd = &ix->nodes[self];
+    *nd = (node){.begin = begin, .end = end, .left = -1, .right = -1};
+    bound(pts, ids + begin, end - begin, nd->lo, nd->hi);
+    bound(nrm, ids + begin, end - begin, nd->nlo, nd->nhi);
+    for (int c = 0; c < 3; c++) {
+        float m = fabsf(nd->nlo[c]) > fabsf(nd->nhi[c]) ? fabsf(nd->nlo[c]) : fabsf(nd->nhi[c]);
+        nd->nmax = m > nd->nmax ? m : nd->nmax;
+    }
+    if (end - begin <= LEAF) return self;
+    int axis = 0;
+    for (int c = 1; c < 3; c++)
+        if (nd->hi[c] - nd->lo[c] > nd->hi[axis] - nd->lo[axis]) axis = c;
+    int half = (end - begin) / 2;
+    select_nth(pts, axis, ids + begin, end - begin, half);
+    nd->axis = axis, nd->split = pts[3 * (size_t)ids[begin + half] + axis];
+    int left = build_node(ix, pts, nrm, ids, begin, begin + half);
+    int right = build_node(ix, pts, nrm, ids, begin + half, end);
+    ix->nodes[self].left = left, ix->nodes[self].right = right;
+    return self;
+}
+
+int nricp_compat_build(const float *pts, const float *nrm, int n, nricp_compat_index **out, tcb_error *err)
+{
+    *out = NULL;
+    if (n < 1) return tcb_fail(err, TCB_ERR_INTERNAL, "nricp: an index over %d points", n);
+    nricp_compat_index *ix = calloc(1, sizeof *ix);
+    if (!ix) return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory");
+    ix->n = n;
+    ix->x = malloc((size_t)n * 6 * sizeof *ix->x);
+    ix->id = malloc((size_t)n * sizeof *ix->id);
+    ix->nodes = malloc((size_t)count_nodes(n) * sizeof *ix->nodes);
+    if (!ix->x || !ix->id || !ix->nodes) {
+        nricp_compat_free(ix);
+        return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory for an index of %d points", n);
+    }
+    for (int i = 0; i < n; i++) ix->id[i] = i;
+    build_node(ix, pts, nrm, ix->id, 0, n);
+    float *col[6];
+    for (int c = 0; c < 6; c++) col[c] = ix->x + (size_t)c * n;
+    ix->y = col[1], ix->z = col[2], ix->nx = col[3], ix->ny = col[4], ix->nz = col[5];
+    for (int i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++) {
+            col[c][i] = pts[3 * (size_t)ix->id[i] + c];
+            col[3 + c][i] = nrm[3 * (size_t)ix->id[i] + c];
+        }
+    *out = ix;
+    return TCB_OK;
+}
+
+/* A node's position box from its points (a leaf) or its children. */
+static void refit_node(nricp_compat_index *ix, node *nd)
+{
+    if (nd->left >= 0) {
+        const node *a = &ix->nodes[nd->left], *b = &ix->nodes[nd->right];
+        for (int c = 0; c < 3; c++) {
+            nd->lo[c] = a->lo[c] < b->lo[c] ? a->lo[c] : b->lo[c];
+            nd->hi[c] = a->hi[c] > b->hi[c] ? a->hi[c] : b->hi[c];
+        }
+        return;
+    }
+    const float *col[3] = {ix->x, ix->y, ix->z};
+    for (int c = 0; c < 3; c++) {
+        float lo = col[c][nd->begin], hi = lo;
+        for (int i = nd->begin + 1; i < nd->end; i++) {
+            lo = col[c][i] < lo ? col[c][i] : lo;
+            hi = col[c][i] > hi ? col[c][i] : hi;
+        }
+        nd->lo[c] = lo, nd->hi[c] = hi;
+    }
+}
+
+void nricp_compat_move(nricp_compat_index *ix, const float *pts)
+{
+    for (int i = 0; i < ix->n; i++) {
+        const float *p = pts + 3 * (size_t)ix->id[i];
+        ix->x[i] = p[0], ix->y[i] = p[1], ix->z[i] = p[2];
+    }
+    /* nodes are numbered parent before children: children are refitted first */
+    for (int at = ix->n_nodes - 1; at >= 0; at--) refit_node(ix, &ix->nodes[at]);
+}
+
+void nricp_compat_free(nricp_compat_index *ix)
+{
+    if (!ix) return;
+    free(ix->x), free(ix->id), free(ix->nodes);
+    free(ix);
+}
+
+/* ---- search ------------------------------------------------------------------ */
+
+typedef struct search {
+    const float *p, *n; /* the query */
+    float n_margin;     /* the normal test's rounding margin, but for the node's scale */
+    int k, found;
+    int32_t *idx;       /* [k] by (d², index) */
+    float *d2;          /* [k] */
+} search;
+
+/* May a point of the node face the query's way? The largest n · m over
+ * the node's normal box, against a margin well above the float dot's
+ * rounding (≤ 3 · 2⁻²⁴ · |n|₁ · max|m_c|): never prunes a compatible point. */
+static int normals_may_fit(const node *nd, const search *s)
+{
+    float best = 0;
+    for (int c = 0; c < 3; c++) {
+        float a = s->n[c] * nd->nlo[c], b = s->n[c] * nd->nhi[c];
+        best += a > b ? a : b;
+    }
+    return best >= -s->n_margin * nd->nmax;
+}
+
+/* The squared distance from p to the node's box (0 inside). */
+static float box_gap(const node *nd, const float *p)
+{
+    float d = 0;
+    for (int c = 0; c < 3; c++) {
+        float below = nd->lo[c] - p[c], above = p[c] - nd->hi[c];
+        float g = below > 0 ? below : above > 0 ? above : 0;
+        d += g * g;
+    }
+    return d;
+}
+
+/* May a point at squared distance ≥ gap displace the current k-th? With a
+ * margin well above the rounding of both float d² (a few 2⁻²⁴ relative). */
+static int near_enough(float gap, const search *s)
+{
+    return s->found < s->k || gap <= s->d2[s->k - 1] * (1 + 1e-5f);
+}
+
+/* Insert (d2, id) into the sorted k best when it belongs there. */
+static void offer(search *s, float d2, int32_t id)
+{
+    int at, last = s->k - 1;
+    if (s->found < s->k) at = s->found++;
+    else if (d2 < s->d2[last] || (d2 == s->d2[last] && id < s->idx[last])) at = last;
+    else return;
+    while (at > 0 && (d2 < s->d2[at - 1] || (d2 == s->d2[at - 1] && id < s->idx[at - 1]))) {
+        s->d2[at] = s->d2[at - 1], s->idx[at] = s->idx[at - 1];
+        at--;
+    }
+    s->d2[at] = d2, s->idx[at] = id;
+}
+
+/* The leaf's d² in lanes (an incompatible point's is +inf: the dot's sum
+ * in x, y, z order, as the contract says), then the offers in order. */
+static void scan_leaf(const nricp_compat_index *ix, const node *nd, search *s)
+{
+    float d2[LEAF];
+    int m = nd->end - nd->begin;
+    const float *x = ix->x + nd->begin, *y = ix->y + nd->begin, *z = ix->z + nd->begin;
+    const float *nx = ix->nx + nd->begin, *ny = ix->ny + nd->begin, *nz = ix->nz + nd->begin;
+    for (int i = 0; i < m; i++) {
+        float dot = s->n[0] * nx[i] + s->n[1] * ny[i] + s->n[2] * nz[i];
+        float dx = s->p[0] - x[i], dy = s->p[1] - y[i], dz = s->p[2] - z[i];
+        float d = dx * dx + dy * dy + dz * dz;
+        d2[i] = dot >= 0.0f ? d : INFINITY;
+    }
+    for (int i = 0; i < m; i++)
+        if (d2[i] != INFINITY) offer(s, d2[i], ix->id[nd->begin + i]);
+}
+
+/* Depth first, the child on the query's side of the split first. gap is
+ * a lower bound of the node's box_gap: the near child inherits its
+ * parent's (it is rarely pruned), the far one gets its own. */
+static void visit(const nricp_compat_index *ix, int at, float gap, search *s)
+{
+    const node *nd = &ix->nodes[at];
+    if (!near_enough(gap, s) || !normals_may_fit(nd, s)) return;
+    if (nd->left < 0) {
+        scan_leaf(ix, nd, s);
+        return;
+    }
+    int near = s->p[nd->axis] < nd->split ? nd->left : nd->right, far = near == nd->left ? nd->right : nd->left;
+    visit(ix, near, gap, s);
+    const node *f = &ix->nodes[far];
+    visit(ix, far, box_gap(f, s->p), s);
+}
+
+int nricp_knn_compat(const nricp_compat_index *ix, const float *qp, const float *qn, int nq, int k,
+                     int32_t *idx, float *d2, int *cnt, tcb_error *err)
+{
     if (k < 1) return tcb_fail(err, TCB_ERR_INTERNAL, "nricp: k-NN with k = %d", k);
-    if (nq <= 0) return TCB_OK;
-    int32_t *pend = malloc((size_t)nq * sizeof *pend);
-    if (!pend) return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory");
-    int np = nq, rc = TCB_OK;
-    int block = 2 * k > FIRST_BLOCK ? 2 * k : FIRST_BLOCK;
-    if (k == 1) {
-        rc = pass_nearest(nn, nrm, qp, qn, nq, pend, &np, idx, d2, cnt, err);
-    } else {
-        for (int q = 0; q < nq; q++) pend[q] = q;
+    float *dist = malloc((size_t)k * sizeof *dist);
+    if (!dist) return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory");
+    for (int q = 0; q < nq; q++) {
+        const float *n = qn + 3 * (size_t)q;
+        search s = {qp + 3 * (size_t)q, n, 1e-6f * (fabsf(n[0]) + fabsf(n[1]) + fabsf(n[2])), k, 0,
+                    idx + (size_t)q * k, dist};
+        visit(ix, 0, box_gap(&ix->nodes[0], s.p), &s);
+        cnt[q] = s.found;
+        for (int a = s.found; a < k; a++) s.idx[a] = -1, dist[a] = 0.0f;
+        if (d2) memcpy(d2 + (size_t)q * k, dist, (size_t)k * sizeof *dist);
     }
-    for (;;) {
-        if (block > n) block = n;
-        if (rc || np == 0) break;
-        rc = pass(nn, nrm, qp, qn, k, block, pend, &np, idx, d2, cnt, err);
-        if (block == n) break;
-        block *= GROWTH;
-    }
-    free(pend);
-    return rc;
+    free(dist);
+    return TCB_OK;
 }

@@ -21,7 +21,6 @@
 #include <stdlib.h>
 
 #include "methods/nricp/knn_compat.h"
-#include "tcb/nn.h"
 
 /* Kernel constant 0.5·(D+2)/V_D with D = 6 and V_6 = π³/6, the unit
  * 6-ball's volume (the Epanechnikov normalisation Thea uses). */
@@ -35,7 +34,7 @@ typedef struct cloud {
     const float *p;    /* [n][3] positions */
     const float *nrm;  /* [n][3] normals */
     int n;
-    tcb_nn *nn;        /* index over p */
+    nricp_compat_index *ix; /* index over p and nrm */
     int k;             /* graph row width */
     int32_t *nbr;      /* [n][k] graph: ≤ k nearest compatible points, self included */
     int *nbr_cnt;      /* [n] */
@@ -53,6 +52,7 @@ typedef struct scratch {
     int32_t *idx;      /* [n] */
     int *cnt;          /* [n] */
     offsets tmp;       /* Jacobi double buffer */
+    nricp_compat_index *deformed; /* the deformed target's index, built by the first blend */
 } scratch;
 
 /* ---- input checks ------------------------------------------------------- */
@@ -103,16 +103,6 @@ static void apply_offsets(const float *base, const offsets *o, int n, float *out
     for (size_t x = 0; x < 3 * (size_t)n; x++) out[x] = base[x] + o->v[x];
 }
 
-/* Always FLANN's exact kd-tree rather than tcb_nn_build's size rule, which
- * is tuned for about one query per indexed point: a registration asks ~75
- * queries per point of each index, coherent from round to round, and there
- * the tree is twice as fast as brute force already at 1.3k–2.5k points
- * (0.05 s against 0.12 s per 2500-point pair on one core). */
-static int build_index(const float *p, int n, tcb_nn **out, tcb_error *err)
-{
-    return tcb_nn_build_backend(p, n, TCB_NN_KDTREE, out, err);
-}
-
 /* ---- the neighbour graph and its kernel weights ------------------------- */
 
 /* h_i² = 4·(distance to the farthest kept neighbour)², w = c·max(0, 1 − r²/h²).
@@ -143,15 +133,15 @@ static int cloud_init(cloud *c, const float *p, const float *nrm, int n, int k, 
     c->nbr_cnt = malloc((size_t)n * sizeof *c->nbr_cnt);
     c->w = malloc((size_t)n * c->k * sizeof *c->w);
     if (!c->nbr || !c->nbr_cnt || !c->w) return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory");
-    int rc = build_index(p, n, &c->nn, err);
-    if (!rc) rc = nricp_knn_compat(c->nn, nrm, p, nrm, n, c->k, c->nbr, NULL, c->nbr_cnt, err);
+    int rc = nricp_compat_build(p, nrm, n, &c->ix, err);
+    if (!rc) rc = nricp_knn_compat(c->ix, p, nrm, n, c->k, c->nbr, NULL, c->nbr_cnt, err);
     if (!rc) graph_weights(c);
     return rc;
 }
 
 static void cloud_free(cloud *c)
 {
-    tcb_nn_free(c->nn);
+    nricp_compat_free(c->ix);
     free(c->nbr), free(c->nbr_cnt), free(c->w);
 }
 
@@ -194,11 +184,12 @@ static void smooth(const cloud *c, offsets *o, offsets *tmp, int iters)
 
 /* o_i ← to.p[nn] − base_i, nn = the point of `to` nearest to queries[i]
  * whose normal is compatible with from_nrm[i]; invalid when there is none.
- * `index` is an index over to.p itself or over a moved copy of it (same ids). */
-static int snap(const tcb_nn *index, const cloud *to, const float *queries, const float *base,
+ * `index` is an index over to.p itself or over a moved copy of it (same ids
+ * and normals). */
+static int snap(const nricp_compat_index *index, const cloud *to, const float *queries, const float *base,
                 const float *from_nrm, int nq, offsets *o, scratch *s, tcb_error *err)
 {
-    int rc = nricp_knn_compat(index, to->nrm, queries, from_nrm, nq, 1, s->idx, NULL, s->cnt, err);
+    int rc = nricp_knn_compat(index, queries, from_nrm, nq, 1, s->idx, NULL, s->cnt, err);
     for (int i = 0; !rc && i < nq; i++) {
         o->ok[i] = s->cnt[i] > 0;
         for (int x = 0; x < 3; x++)
@@ -212,7 +203,7 @@ static int snap(const tcb_nn *index, const cloud *to, const float *queries, cons
 static int snap_update(const cloud *from, const cloud *to, offsets *o, scratch *s, tcb_error *err)
 {
     apply_offsets(from->p, o, from->n, s->pts);
-    return snap(to->nn, to, s->pts, from->p, from->nrm, from->n, o, s, err);
+    return snap(to->ix, to, s->pts, from->p, from->nrm, from->n, o, s, err);
 }
 
 /* ---- bounding-box initialisation ------------------------------------------ */
@@ -263,11 +254,11 @@ static int bbox_offsets(const cloud *from, const cloud *to, offsets *o, scratch 
 {
     bbox bf = bbox_of(from->p, from->n), bt = bbox_of(to->p, to->n);
     bbox_map(&bt, &bf, to->p, to->n, s->pts);
-    tcb_nn *moved;
-    int rc = build_index(s->pts, to->n, &moved, err);
+    nricp_compat_index *moved;
+    int rc = nricp_compat_build(s->pts, to->nrm, to->n, &moved, err);
     if (rc) return rc;
     rc = snap(moved, to, from->p, from->p, from->nrm, from->n, o, s, err);
-    tcb_nn_free(moved);
+    nricp_compat_free(moved);
     return rc;
 }
 
@@ -280,9 +271,10 @@ static int blend(const cloud *S, const cloud *T, offsets *d, const offsets *e, s
                  tcb_error *err)
 {
     apply_offsets(T->p, e, T->n, s->pts);
-    tcb_nn *deformed;
-    int rc = build_index(s->pts, T->n, &deformed, err);
-    if (!rc) rc = nricp_knn_compat(deformed, T->nrm, S->p, S->nrm, S->n, 1, s->idx, NULL, s->cnt, err);
+    int rc = TCB_OK;
+    if (s->deformed) nricp_compat_move(s->deformed, s->pts);
+    else rc = nricp_compat_build(s->pts, T->nrm, T->n, &s->deformed, err);
+    if (!rc) rc = nricp_knn_compat(s->deformed, S->p, S->nrm, S->n, 1, s->idx, NULL, s->cnt, err);
     for (int i = 0; !rc && i < S->n; i++) {
         if (!s->cnt[i] || !e->ok[s->idx[i]]) continue;
         const float *ej = e->v + 3 * (size_t)s->idx[i];
@@ -290,7 +282,6 @@ static int blend(const cloud *S, const cloud *T, offsets *d, const offsets *e, s
         for (int x = 0; x < 3; x++) di[x] = d->ok[i] ? 0.5f * di[x] - 0.5f * ej[x] : -ej[x];
         d->ok[i] = 1;
     }
-    tcb_nn_free(deformed);
     return rc;
 }
 
@@ -339,7 +330,7 @@ int nricp_register(const float *src, const float *src_nrm, int n_src, const floa
     cloud S = {0}, T = {0};
     offsets d = {0}, e = {0};
     scratch s = {malloc((size_t)n * 3 * sizeof(float)), malloc((size_t)n * sizeof(int32_t)),
-                 malloc((size_t)n * sizeof(int)), {0}};
+                 malloc((size_t)n * sizeof(int)), {0}, NULL};
     if (!s.pts || !s.idx || !s.cnt || !offsets_alloc(&s.tmp, n) || !offsets_alloc(&d, n_src) ||
         !offsets_alloc(&e, n_dst))
         rc = tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory for %d + %d points", n_src, n_dst);
@@ -350,5 +341,6 @@ int nricp_register(const float *src, const float *src_nrm, int n_src, const floa
     cloud_free(&S), cloud_free(&T);
     offsets_free(&d), offsets_free(&e), offsets_free(&s.tmp);
     free(s.pts), free(s.idx), free(s.cnt);
+    nricp_compat_free(s.deformed);
     return rc;
 }

@@ -137,48 +137,112 @@ static int brute_compat(const float *pts, const float *nrm, int n, const float *
     return found;
 }
 
-static void random_cloud(tcb_rng *r, float *p, float *nrm, int n)
+/* Random normals make about half the candidates incompatible. A `grid`
+ * cloud sits on a 5-step lattice, so many points coincide and many
+ * distances tie exactly: the (d², index) order decides. */
+static void random_cloud(tcb_rng *r, float *p, float *nrm, int n, int grid)
 {
-    for (int i = 0; i < 3 * n; i++) p[i] = (float)tcb_rng_uniform(r);
+    for (int i = 0; i < 3 * n; i++) {
+        float u = (float)tcb_rng_uniform(r);
+        p[i] = grid ? floorf(u * 5) / 4 : u;
+    }
     for (int i = 0; i < 3 * n; i++) nrm[i] = (float)tcb_rng_normal(r);
 }
 
-static void check_knn(tcb_nn_backend backend, int n, int k)
+/* Points on the unit sphere with outward normals, queried near the sphere
+ * with inward ones: every compatible point lies on the far hemisphere, so
+ * the nearest are far and whole subtrees must be skipped by their normals
+ * (a registration's frames far apart). */
+static void sphere_cloud(tcb_rng *r, float *p, float *nrm, int n, float flip)
 {
-    enum { NQ = 200 };
-    float *p = malloc((size_t)n * 12), *nrm = malloc((size_t)n * 12), q[NQ * 3], qn[NQ * 3];
-    int32_t *idx = malloc((size_t)NQ * k * sizeof *idx), *ref = malloc((size_t)k * sizeof *ref);
-    int cnt[NQ];
-    tcb_rng r;
-    tcb_rng_seed_stream(&r, 7, "test/knn_compat");
-    random_cloud(&r, p, nrm, n);
-    random_cloud(&r, q, qn, NQ);
-    tcb_error err;
-    tcb_nn *nn;
-    assert_int_equal(tcb_nn_build_backend(p, n, backend, &nn, &err), TCB_OK);
-    assert_int_equal(nricp_knn_compat(nn, nrm, q, qn, NQ, k, idx, NULL, cnt, &err), TCB_OK);
-    for (int t = 0; t < NQ; t++) {
-        int want = brute_compat(p, nrm, n, q + 3 * t, qn + 3 * t, k, ref);
-        assert_int_equal(cnt[t], want);
-        assert_memory_equal(idx + (size_t)t * k, ref, (size_t)want * sizeof *ref);
-        for (int a = want; a < k; a++) assert_int_equal(idx[(size_t)t * k + a], -1);
+    for (int i = 0; i < n; i++) {
+        double v[3], len = 0;
+        for (int c = 0; c < 3; c++) v[c] = tcb_rng_normal(r), len += v[c] * v[c];
+        for (int c = 0; c < 3; c++) {
+            nrm[3 * i + c] = flip * (float)(v[c] / sqrt(len));
+            p[3 * i + c] = (float)(v[c] / sqrt(len)) * (1 + 0.05f * (float)tcb_rng_uniform(r));
+        }
     }
-    tcb_nn_free(nn);
-    free(p), free(nrm), free(idx), free(ref);
 }
 
-/* Random normals make about half the candidates incompatible, so k = 8
- * regularly needs the widened second block. */
+/* Every query's k results against brute_compat over (pts, nrm). */
+static void expect_exact(const nricp_compat_index *ix, const float *pts, const float *nrm, int n, const float *q,
+                         const float *qn, int nq, int k)
+{
+    int32_t *idx = malloc((size_t)nq * k * sizeof *idx), *ref = malloc((size_t)k * sizeof *ref);
+    float *d2 = malloc((size_t)nq * k * sizeof *d2);
+    int *cnt = malloc((size_t)nq * sizeof *cnt);
+    tcb_error err;
+    assert_int_equal(nricp_knn_compat(ix, q, qn, nq, k, idx, d2, cnt, &err), TCB_OK);
+    for (int t = 0; t < nq; t++) {
+        int want = brute_compat(pts, nrm, n, q + 3 * t, qn + 3 * t, k, ref);
+        assert_int_equal(cnt[t], want);
+        assert_memory_equal(idx + (size_t)t * k, ref, (size_t)want * sizeof *ref);
+        for (int a = 0; a < want; a++) {
+            const float *c = pts + 3 * (size_t)ref[a], *o = q + 3 * (size_t)t;
+            float dx = c[0] - o[0], dy = c[1] - o[1], dz = c[2] - o[2];
+            assert_true(d2[(size_t)t * k + a] == dx * dx + dy * dy + dz * dz);
+        }
+        for (int a = want; a < k; a++) assert_int_equal(idx[(size_t)t * k + a], -1);
+    }
+    free(idx), free(ref), free(d2), free(cnt);
+}
+
+enum { NQ = 200 };
+
+static void check_knn(int n, int k, int grid)
+{
+    float *p = malloc((size_t)n * 12), *nrm = malloc((size_t)n * 12), q[NQ * 3], qn[NQ * 3];
+    tcb_rng r;
+    tcb_rng_seed_stream(&r, 7, "test/knn_compat");
+    random_cloud(&r, p, nrm, n, grid);
+    random_cloud(&r, q, qn, NQ, grid);
+    tcb_error err;
+    nricp_compat_index *ix;
+    assert_int_equal(nricp_compat_build(p, nrm, n, &ix, &err), TCB_OK);
+    expect_exact(ix, p, nrm, n, q, qn, NQ, k);
+    nricp_compat_free(ix);
+    free(p), free(nrm);
+}
+
 static void test_knn_compat_is_exact(void **state)
 {
     (void)state;
-    check_knn(TCB_NN_BRUTE, 500, 1);
-    check_knn(TCB_NN_BRUTE, 500, 8);
-    check_knn(TCB_NN_KDTREE, 500, 3);
-    check_knn(TCB_NN_BRUTE, 5, 8); /* k > n: everything compatible, no more */
+    check_knn(500, 1, 0);
+    check_knn(500, 8, 0);
+    check_knn(3000, 3, 0);
+    check_knn(500, 8, 1); /* ties: 125 lattice sites for 500 points */
+    check_knn(5, 8, 0);   /* k > n: everything compatible, no more */
 }
 
-/* Every candidate faces away: nothing is found, after widening to all. */
+/* The nearest compatible points on the far side: found exactly, and
+ * after the index is moved (a tree split for other positions). */
+static void test_knn_compat_far_side_and_moved(void **state)
+{
+    (void)state;
+    enum { N = 4000 };
+    float *p = malloc(N * 12), *nrm = malloc(N * 12), *moved = malloc(N * 12), q[NQ * 3], qn[NQ * 3];
+    tcb_rng r;
+    tcb_rng_seed_stream(&r, 8, "test/knn_compat/sphere");
+    sphere_cloud(&r, p, nrm, N, 1);
+    sphere_cloud(&r, q, qn, NQ, -1);
+    tcb_error err;
+    nricp_compat_index *ix;
+    assert_int_equal(nricp_compat_build(p, nrm, N, &ix, &err), TCB_OK);
+    expect_exact(ix, p, nrm, N, q, qn, NQ, 1);
+    expect_exact(ix, p, nrm, N, q, qn, NQ, 8);
+    /* each point moved to another's place (a reversal: the tree's boxes
+     * now hold scattered points) and shifted */
+    for (int i = 0; i < N; i++)
+        for (int c = 0; c < 3; c++) moved[3 * i + c] = p[3 * (N - 1 - i) + c] + (c == 0 ? 0.5f : 0.0f);
+    nricp_compat_move(ix, moved);
+    expect_exact(ix, moved, nrm, N, q, qn, NQ, 1);
+    expect_exact(ix, moved, nrm, N, q, qn, NQ, 8);
+    nricp_compat_free(ix);
+    free(p), free(nrm), free(moved);
+}
+
+/* Every candidate faces away: nothing is found. */
 static void test_knn_compat_none_compatible(void **state)
 {
     (void)state;
@@ -188,14 +252,14 @@ static void test_knn_compat_none_compatible(void **state)
     int32_t idx[2];
     int cnt;
     tcb_error err;
-    tcb_nn *nn;
-    assert_int_equal(tcb_nn_build(p, 4, &nn, &err), TCB_OK);
-    assert_int_equal(nricp_knn_compat(nn, nrm, q, qn, 1, 1, idx, NULL, &cnt, &err), TCB_OK);
+    nricp_compat_index *ix;
+    assert_int_equal(nricp_compat_build(p, nrm, 4, &ix, &err), TCB_OK);
+    assert_int_equal(nricp_knn_compat(ix, q, qn, 1, 1, idx, NULL, &cnt, &err), TCB_OK);
     assert_int_equal(cnt, 0);
     assert_int_equal(idx[0], -1);
-    assert_int_equal(nricp_knn_compat(nn, nrm, q, qn, 1, 2, idx, NULL, &cnt, &err), TCB_OK);
+    assert_int_equal(nricp_knn_compat(ix, q, qn, 1, 2, idx, NULL, &cnt, &err), TCB_OK);
     assert_int_equal(cnt, 0);
-    tcb_nn_free(nn);
+    nricp_compat_free(ix);
 }
 
 /* ---- registration ------------------------------------------------------------------ */
@@ -1052,6 +1116,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_knn_compat_is_exact),
+        cmocka_unit_test(test_knn_compat_far_side_and_moved),
         cmocka_unit_test(test_knn_compat_none_compatible),
         cmocka_unit_test(test_register_recovers_synthetic_motion),
         cmocka_unit_test(test_register_identity),
