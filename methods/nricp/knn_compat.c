@@ -13,9 +13,9 @@
  * what a plain one does, however the clouds are posed.
  *
  * The tree splits at the median of the widest axis (ties by index, so the
- * tree depends on the input alone) down to LEAF points. Pruning is
- * conservative by a margin above float rounding, so the results are those
- * of an exhaustive scan in the same arithmetic. */
+ * tree depends on the input alone) down to LEAF points. Its bounds are
+ * exact in float arithmetic (below), so the results are those of an
+ * exhaustive scan, exact ties included. */
 #include "methods/nricp/knn_compat.h"
 
 #include <math.h>
@@ -27,8 +27,8 @@
 typedef struct node {
     float lo[3], hi[3];   /* bounds of the points' positions */
     float nlo[3], nhi[3]; /* bounds of their normals */
-    float nmax;           /* their largest |component| */
     int begin, end;       /* its points: [begin, end) of the index's order */
+    int32_t min_id;       /* their lowest caller's index (an exact tie goes to the lower) */
     int left, right;      /* children; -1 for a leaf */
     int axis;             /* the split: left's points ≤ split ≤ right's along axis as */
     float split;          /* built; after a move, only which child a search tries first */
@@ -97,10 +97,8 @@ static int build_node(nricp_compat_index *ix, const float *pts, const float *nrm
     *nd = (node){.begin = begin, .end = end, .left = -1, .right = -1};
     bound(pts, ids + begin, end - begin, nd->lo, nd->hi);
     bound(nrm, ids + begin, end - begin, nd->nlo, nd->nhi);
-    for (int c = 0; c < 3; c++) {
-        float m = fabsf(nd->nlo[c]) > fabsf(nd->nhi[c]) ? fabsf(nd->nlo[c]) : fabsf(nd->nhi[c]);
-        nd->nmax = m > nd->nmax ? m : nd->nmax;
-    }
+    nd->min_id = ids[begin];
+    for (int i = begin + 1; i < end; i++) nd->min_id = ids[i] < nd->min_id ? ids[i] : nd->min_id;
     if (end - begin <= LEAF) return self;
     int axis = 0;
     for (int c = 1; c < 3; c++)
@@ -185,15 +183,19 @@ void nricp_compat_free(nricp_compat_index *ix)
 
 typedef struct search {
     const float *p, *n; /* the query */
-    float n_margin;     /* the normal test's rounding margin, but for the node's scale */
     int k, found;
     int32_t *idx;       /* [k] by (d², index) */
     float *d2;          /* [k] */
 } search;
 
+/* Both tests below are exact bounds in float arithmetic, not estimates:
+ * they evaluate the same expressions, in the same order, as the point's own
+ * test (the dot n · m summed x, y, z; d² = (dx² + dy²) + dz²) on the box's
+ * ends, and rounding is monotone, so no point of the box can do better than
+ * its bound — a search prunes only what an exhaustive scan would reject. */
+
 /* May a point of the node face the query's way? The largest n · m over
- * the node's normal box, against a margin well above the float dot's
- * rounding (≤ 3 · 2⁻²⁴ · |n|₁ · max|m_c|): never prunes a compatible point. */
+ * the node's normal box. */
 static int normals_may_fit(const node *nd, const search *s)
 {
     float best = 0;
@@ -201,10 +203,10 @@ static int normals_may_fit(const node *nd, const search *s)
         float a = s->n[c] * nd->nlo[c], b = s->n[c] * nd->nhi[c];
         best += a > b ? a : b;
     }
-    return best >= -s->n_margin * nd->nmax;
+    return best >= 0.0f;
 }
 
-/* The squared distance from p to the node's box (0 inside). */
+/* The smallest d² from p to a point of the node's box (0 inside). */
 static float box_gap(const node *nd, const float *p)
 {
     float d = 0;
@@ -216,11 +218,13 @@ static float box_gap(const node *nd, const float *p)
     return d;
 }
 
-/* May a point at squared distance ≥ gap displace the current k-th? With a
- * margin well above the rounding of both float d² (a few 2⁻²⁴ relative). */
-static int near_enough(float gap, const search *s)
+/* May a point of the node, at d² ≥ gap, displace the current k-th? At an
+ * exact tie only one of a lower index. */
+static int near_enough(const node *nd, float gap, const search *s)
 {
-    return s->found < s->k || gap <= s->d2[s->k - 1] * (1 + 1e-5f);
+    if (s->found < s->k) return 1;
+    float worst = s->d2[s->k - 1];
+    return gap < worst || (gap == worst && nd->min_id < s->idx[s->k - 1]);
 }
 
 /* Insert (d2, id) into the sorted k best when it belongs there. */
@@ -261,7 +265,7 @@ static void scan_leaf(const nricp_compat_index *ix, const node *nd, search *s)
 static void visit(const nricp_compat_index *ix, int at, float gap, search *s)
 {
     const node *nd = &ix->nodes[at];
-    if (!near_enough(gap, s) || !normals_may_fit(nd, s)) return;
+    if (!near_enough(nd, gap, s) || !normals_may_fit(nd, s)) return;
     if (nd->left < 0) {
         scan_leaf(ix, nd, s);
         return;
@@ -280,8 +284,7 @@ int nricp_knn_compat(const nricp_compat_index *ix, const float *qp, const float 
     if (!dist) return tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory");
     for (int q = 0; q < nq; q++) {
         const float *n = qn + 3 * (size_t)q;
-        search s = {qp + 3 * (size_t)q, n, 1e-6f * (fabsf(n[0]) + fabsf(n[1]) + fabsf(n[2])), k, 0,
-                    idx + (size_t)q * k, dist};
+        search s = {qp + 3 * (size_t)q, n, k, 0, idx + (size_t)q * k, dist};
         visit(ix, 0, box_gap(&ix->nodes[0], s.p), &s);
         cnt[q] = s.found;
         for (int a = s.found; a < k; a++) s.idx[a] = -1, dist[a] = 0.0f;
