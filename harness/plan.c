@@ -195,17 +195,54 @@ static int add_cell_seconds(plan_totals *t, double seconds)
     return TCB_OK;
 }
 
+/* A finished cell of the same method on the same sequence, another seed's,
+ * prices this one from what it measured: its fit, and its evaluation per
+ * pair times this cell's pairs. A measurement knows what the counts the
+ * calibration scales by do not (how far apart the frames of a pair lie, how
+ * a shape's thin parts lengthen a search: docs/cluster.md). 0 when no such
+ * cell is there. */
+static int price_from_sibling(const plan_walk *w, const tcb_grid_cell *c, tcb_cost_estimate *e)
+{
+    const tcb_method_spec *m = c->method;
+    for (int k = 0; k < m->n_seeds; k++) {
+        char path[TCB_PATH_MAX];
+        tcb_error err = {0};
+        tcb_cell_result r;
+        if (m->seeds[k] == c->seed ||
+            tcb_cell_path(path, sizeof path, w->run_dir, c->dataset->name, c->sequence->name, m->label, m->seeds[k],
+                          &err) ||
+            !tcb_is_file(path) || tcb_cell_load(path, &r, &err))
+            continue;
+        /* the clip protocol's transfers count as pairs, as in the query */
+        int pairs = r.n_pairs + r.n_clips * (TCB_CLIP_FRAMES - 1);
+        int ok = r.status == TCB_CELL_OK && pairs > 0 && r.fit_s >= 0 && r.eval_s >= 0;
+        if (ok) {
+            char fit[32], eval[32];
+            duration_text(r.fit_s, fit, sizeof fit);
+            duration_text(r.eval_s, eval, sizeof eval);
+            e->fit_s = r.fit_s;
+            e->eval_s = r.eval_s * w->q.n_pairs / pairs;
+            snprintf(e->basis, sizeof e->basis, "measured: seed %d's cell (fit %s, evaluation %s for %d pairs)",
+                     m->seeds[k], fit, eval, pairs);
+        }
+        tcb_cell_free(&r);
+        if (ok) return 1;
+    }
+    return 0;
+}
+
 static int plan_cell(void *ctx, const tcb_grid_cell *c)
 {
     plan_walk *w = ctx;
     if (!tcb_run_selected(w->opts, c->method) || (w->opts->cells && !w->opts->cells[c->id])) return TCB_OK;
     if (w->current != c->sequence) sequence_header(w, c->dataset, c->sequence);
     w->current = c->sequence;
-    tcb_cost_estimate e;
-    estimate_cell(w->cals, c->method, &w->q, w->cfg->surface_samples, &e);
     char state[TCB_PATH_MAX];
     cell_state(w->run_dir, w->opts, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state);
     int runs = w->opts->force || state_runs(state);
+    tcb_cost_estimate e;
+    estimate_cell(w->cals, c->method, &w->q, w->cfg->surface_samples, &e);
+    if (runs) price_from_sibling(w, c, &e);
     char fit[32], eval[32];
     duration_text(e.fit_s, fit, sizeof fit);
     duration_text(e.eval_s, eval, sizeof eval);

@@ -118,6 +118,25 @@ assert abs(sec(*total.groups()) - sum(cells)) <= slack(*total.groups()) + 3, tex
 assert abs(sec(*wall.groups()) - max(a, b, min(a, b) + c)) <= slack(*wall.groups()) + 3, text
 PY
 
+# A finished cell prices the same method's other seeds on the sequence:
+# seed 1's fit is seed 0's measured fit, its evaluation seed 0's per pair
+# times its pairs (the same 24 here), over what the calibration says.
+sed 's/"seeds": \[0\]/"seeds": [0, 1]/' small.json > seeds.json
+expect 0 "measured: seed 0's cell" "$TCBENCH" run seeds.json --dry-run
+/usr/bin/python3 - <<'PY'
+import json, re
+units = {"s": 1, "min": 60, "h": 3600}
+sec = lambda v, u: float(v) * units[u]
+text = open("out.txt").read()
+rows = re.findall(r"(?m)^\s+\d+\s+(\S+)\s+1\s+missing\s+([\d.]+) (s|min|h)\s+([\d.]+) (s|min|h)\s+(.*)$", text)
+assert len(rows) == 3, text
+for method, fv, fu, ev, eu, basis in rows:
+    t = json.load(open(f"run/cells/s/quadruped_walk/{method}/seed_0.json"))["timings"]
+    assert basis.startswith("measured: seed 0's cell (fit ") and basis.endswith(" for 24 pairs)"), basis
+    for v, u, m in ((fv, fu, t["fit_s"]), (ev, eu, t["eval_s"])):
+        assert abs(sec(v, u) - m) <= (0.05 if m < 10 else 0.5), (method, v, u, m)
+PY
+
 # Bad usage and bad files: one line naming what, exit 2.
 expect 2 "--tasks applies to --dry-run only" "$TCBENCH" run small.json --tasks 2
 expect 2 "--only nearest: no method of that name has costs to measure" "$TCBENCH" calibrate --only nearest --out x.json
