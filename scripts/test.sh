@@ -15,7 +15,12 @@ print_stages() { echo "time by stage:"; printf '%s\n' "${stages[@]}"; }
 
 scripts/setup.sh --tests
 stage "packages (scripts/setup.sh --tests)"
-cmake -S . -B build-test -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTCB_SANITIZE=ON >/dev/null
+# Debug information: line tables only (-g1; clang's -gline-tables-only
+# below), what the sanitizers' stack traces print, without the variables
+# and types only a debugger reads: a quarter less compiling (a build to
+# debug in is configured without these two flags: CMake's -g).
+cmake -S . -B build-test -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTCB_SANITIZE=ON \
+    -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" >/dev/null
 cmake --build build-test -j"$(nproc)" >/dev/null
 stage "sanitized build (build-test)"
 # The default benchmark's regression check runs a Release build: its 24
@@ -34,7 +39,7 @@ stage "Release build (build-check)"
 # searches are fuzz/README.md's). The sanitized build above replays their
 # seeds and regressions.
 CC=clang cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTCB_FUZZ=ON -DTCB_BUILD_TESTS=OFF \
-    -DTCB_FUZZ_SMOKE_S=5 >/dev/null
+    -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" -DTCB_FUZZ_SMOKE_S=5 >/dev/null
 cmake --build build-fuzz -j"$(nproc)" --target fuzz_targets >/dev/null
 stage "fuzz targets (build-fuzz, clang)"
 export TCBENCH_RELEASE="$PWD/build-check/tcbench"

@@ -117,7 +117,7 @@ static void test_both_templates(void **state)
 static void test_check_that_cannot_pass(void **state)
 {
     body *b = *state;
-    tcb_pcgrid_template_spec pdg = {.gt_normals = 1, .poisson_depth = 8, .template_faces = 40, .remesh_iterations = 1,
+    tcb_pcgrid_template_spec pdg = {.gt_normals = 1, .poisson_depth = 6, .template_faces = 40, .remesh_iterations = 1,
                                     .check_samples = 2000, .max_rounds = 2, .check_chamfer = 1e-9};
     tcb_mesh t = {0, 0, NULL, NULL};
     tcb_error err = {0};
