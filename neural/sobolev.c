@@ -72,15 +72,22 @@ void tcb_sobolev_free(tcb_sobolev *s)
     memset(s, 0, sizeof *s);
 }
 
+/* Below this many multiply-adds a transform runs on one thread: a team
+ * costs more than the work (batchnorm.c's threshold). */
+#define PAR_MIN 32768.0
+
 /* In place along one axis of a [r][r][r][F] array (element stride `step`
- * along the axis): a ← Qᵀ a (to the eigenbasis) or a ← Q a (back). */
-static void transform_axis(const double *Q, int r, int F, size_t step, int to_basis, double *a,
-                           double *line)
+ * along the axis): a ← Qᵀ a (to the eigenbasis) or a ← Q a (back). The
+ * r² lines along the axis are independent: side by side on the threads,
+ * each computed alike on any number of them. Line L starts at node
+ * (L / s)·s·r + L % s, s the axis's node stride (1, r or r²). */
+static void transform_axis(const double *Q, int r, int F, size_t step, int to_basis, double *a)
 {
-    size_t n3 = (size_t)r * r * r;
-    for (size_t base = 0; base < n3; base++) {
-        /* base enumerates nodes; take those whose coordinate on this axis is 0. */
-        if ((base * (size_t)F / step) % (size_t)r) continue;
+    size_t s = step / (size_t)F, lines = (size_t)r * r;
+#pragma omp parallel for schedule(static) if ((double)lines * F * r * r > PAR_MIN)
+    for (size_t L = 0; L < lines; L++) {
+        double line[1024];
+        size_t base = L / s * s * (size_t)r + L % s;
         for (int f = 0; f < F; f++) {
             double *p = a + base * (size_t)F + (size_t)f;
             for (int i = 0; i < r; i++) line[i] = p[(size_t)i * step];
@@ -98,12 +105,11 @@ void tcb_sobolev_solve(const tcb_sobolev *s, int F, const float *u, float *v, do
 {
     int r = s->r;
     size_t n3 = (size_t)r * r * r, steps[3] = {(size_t)F, (size_t)F * r, (size_t)F * r * r};
-    double line[1024];
     for (size_t i = 0; i < n3 * (size_t)F; i++) scratch[i] = u[i];
-    for (int a = 0; a < 3; a++) transform_axis(s->Q, r, F, steps[a], 1, scratch, line);
+    for (int a = 0; a < 3; a++) transform_axis(s->Q, r, F, steps[a], 1, scratch);
     for (size_t node = 0; node < n3; node++)
         for (int f = 0; f < F; f++) scratch[node * (size_t)F + (size_t)f] *= s->gain[node];
-    for (int a = 0; a < 3; a++) transform_axis(s->Q, r, F, steps[a], 0, scratch, line);
+    for (int a = 0; a < 3; a++) transform_axis(s->Q, r, F, steps[a], 0, scratch);
     for (size_t i = 0; i < n3 * (size_t)F; i++) v[i] = (float)scratch[i];
 }
 
