@@ -17,6 +17,7 @@
 #include "tcb/dfaust.h"
 #include "tcb/registry.h"
 #include "tcb/synth.h"
+#include "tcb/sysinfo.h"
 
 typedef struct plan_totals {
     int cells, done, running, to_run;  /* running: held by a live process elsewhere */
@@ -154,6 +155,7 @@ typedef struct plan_walk {
     const tcb_run_opts *opts;
     const char *run_dir;
     const tcb_sequence_spec *current; /* the sequence whose header was printed */
+    char revision[64];                /* tcbench's (tcb_git_revision): a measured cell's must match */
     tcb_cost_query q;
     plan_totals t;
 } plan_walk;
@@ -196,11 +198,12 @@ static int add_cell_seconds(plan_totals *t, double seconds)
 }
 
 /* A finished cell of the same method on the same sequence, another seed's,
- * prices this one from what it measured: its fit, and its evaluation per
- * pair times this cell's pairs. A measurement knows what the counts the
- * calibration scales by do not (how far apart the frames of a pair lie, how
- * a shape's thin parts lengthen a search: docs/cluster.md). 0 when no such
- * cell is there. */
+ * measured by this revision of tcbench, prices this one from what it
+ * measured: its fit, and its evaluation per pair times this cell's pairs.
+ * A measurement knows what the counts the calibration scales by do not (how
+ * far apart the frames of a pair lie, how a shape's thin parts lengthen a
+ * search: docs/cluster.md); one by other code says little about this
+ * code's speed. 0 when no such cell is there. */
 static int price_from_sibling(const plan_walk *w, const tcb_grid_cell *c, tcb_cost_estimate *e)
 {
     const tcb_method_spec *m = c->method;
@@ -215,7 +218,8 @@ static int price_from_sibling(const plan_walk *w, const tcb_grid_cell *c, tcb_co
             continue;
         /* the clip protocol's transfers count as pairs, as in the query */
         int pairs = r.n_pairs + r.n_clips * (TCB_CLIP_FRAMES - 1);
-        int ok = r.status == TCB_CELL_OK && pairs > 0 && r.fit_s >= 0 && r.eval_s >= 0;
+        int ok = r.status == TCB_CELL_OK && pairs > 0 && r.fit_s >= 0 && r.eval_s >= 0 &&
+                 !strcmp(r.git_revision, w->revision);
         if (ok) {
             char fit[32], eval[32];
             duration_text(r.fit_s, fit, sizeof fit);
@@ -298,7 +302,8 @@ int tcb_run_dry(const tcb_config *cfg, const tcb_run_opts *opts, FILE *out, tcb_
     if (rc) return rc;
     fprintf(out, "%s: %s, %d thread%s per cell\n", cfg->path, run_dir, cfg->threads, cfg->threads == 1 ? "" : "s");
     print_sources(out, &cals);
-    plan_walk w = {out, &cals, cfg, opts, run_dir, NULL, {0}, {0}};
+    plan_walk w = {out, &cals, cfg, opts, run_dir, NULL, "", {0}, {0}};
+    tcb_git_revision(w.revision, sizeof w.revision);
     rc = tcb_grid_for_each(cfg, plan_cell, &w);
     if (rc) rc = tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
     else print_totals(out, &w.t, opts->tasks);

@@ -120,7 +120,8 @@ PY
 
 # A finished cell prices the same method's other seeds on the sequence:
 # seed 1's fit is seed 0's measured fit, its evaluation seed 0's per pair
-# times its pairs (the same 24 here), over what the calibration says.
+# times its pairs (the same 24 here), over what the calibration says; a
+# cell measured by another revision of tcbench does not.
 sed 's/"seeds": \[0\]/"seeds": [0, 1]/' small.json > seeds.json
 expect 0 "measured: seed 0's cell" "$TCBENCH" run seeds.json --dry-run
 /usr/bin/python3 - <<'PY'
@@ -136,6 +137,16 @@ for method, fv, fu, ev, eu, basis in rows:
     for v, u, m in ((fv, fu, t["fit_s"]), (ev, eu, t["eval_s"])):
         assert abs(sec(v, u) - m) <= (0.05 if m < 10 else 0.5), (method, v, u, m)
 PY
+/usr/bin/python3 - <<'PY'
+import glob, json
+for p in glob.glob("run/cells/s/quadruped_walk/*/seed_0.json"):
+    c = json.load(open(p))
+    c["git_revision"] = "0000000"
+    json.dump(c, open(p, "w"))
+PY
+"$TCBENCH" run seeds.json --dry-run > other.txt
+! grep -q "measured:" other.txt && grep -qE "^ +[0-9]+ +cc +1 +missing .* steps x" other.txt ||
+    { echo "FAIL: cells of another revision priced the others"; cat other.txt; exit 1; }
 
 # Bad usage and bad files: one line naming what, exit 2.
 expect 2 "--tasks applies to --dry-run only" "$TCBENCH" run small.json --tasks 2
