@@ -7,8 +7,10 @@
 #include "cli/cli.h"
 #include "costs/calibrate.h"
 #include "costs/calibration.h"
+#include "tcb/config.h"
 #include "tcb/fsutil.h"
 #include "tcb/metrics.h"
+#include "tcb/runner.h"
 #include "tcb/sysinfo.h"
 
 /* calibrate --threads: "1,2,16", kept increasing without repeats. */
@@ -34,6 +36,42 @@ static int thread_list(const char *text, int *threads, int max, int *n)
     return 0;
 }
 
+/* The units of cfg's methods on each of its sequences (loaded as `run`
+ * loads them), the budget shared between the sequences; a sequence of an
+ * optional dataset that is absent is skipped, as a run skips it. */
+static int calibrate_on_config(const tcb_config *cfg, tcb_calibrate_opts *o, tcb_error *err)
+{
+    const char **names = calloc((size_t)cfg->n_methods + 1, sizeof *names);
+    if (!names) return tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
+    for (int k = 0; k < cfg->n_methods; k++) names[k] = cfg->methods[k].method;
+    int n_seqs = 0, rc = TCB_OK;
+    for (int d = 0; d < cfg->n_datasets; d++) n_seqs += cfg->datasets[d].n_sequences;
+    o->methods = names, o->n_methods = cfg->n_methods, o->budget_s /= n_seqs > 0 ? n_seqs : 1;
+    rc = tcb_calibrate_check(o, err);
+    for (int d = 0; !rc && d < cfg->n_datasets; d++) {
+        const tcb_dataset_spec *ds = &cfg->datasets[d];
+        for (int k = 0; !rc && k < ds->n_sequences; k++) {
+            char name[TCB_COST_SEQUENCE_MAX];
+            tcb_sequence seq;
+            snprintf(name, sizeof name, "%s/%s", ds->name, ds->sequences[k].name);
+            rc = tcb_run_load_sequence(cfg, ds->name, ds->sequences[k].name, &seq, err);
+            if (rc && ds->optional) {
+                printf("%s: skipped (optional): %s\n", name, err->msg);
+                rc = TCB_OK;
+                continue;
+            }
+            if (rc) break;
+            o->sequence = &seq, o->sequence_name = name;
+            rc = tcb_calibrate(o, stdout, err);
+            if (rc) tcb_error_prefix(err, "%s: ", name);
+            tcb_sequence_free(&seq);
+        }
+    }
+    free(names);
+    if (rc) tcb_error_prefix(err, "%s: ", cfg->path);
+    return rc;
+}
+
 static int cmd_calibrate(const cli_args *c)
 {
     enum { MAX_COUNTS = 16 };
@@ -45,21 +83,29 @@ static int cmd_calibrate(const cli_args *c)
     tcb_calibration_user_path(user, sizeof user);
     const char *out = c->value[F_OUT] ? c->value[F_OUT] : user;
     if (!out[0]) return cli_usage_error("calibrate", "neither HOME nor XDG_CONFIG_HOME is set: give --out FILE");
-    tcb_calibrate_opts o = {threads, n, c->value[F_ONLY], c->value[F_PRESET],
-                            (double)cli_flag_int(c, F_BUDGET, c->set[F_QUICK] ? 60 : 600), c->set[F_QUICK],
-                            (int)cli_flag_int(c, F_SAMPLES, TCB_DEFAULT_SURFACE_SAMPLES), out};
+    tcb_calibrate_opts o = {.threads = threads, .n_threads = n, .method = c->value[F_ONLY],
+                            .preset = c->value[F_PRESET],
+                            .budget_s = (double)cli_flag_int(c, F_BUDGET, c->set[F_QUICK] ? 60 : 600),
+                            .quick = c->set[F_QUICK],
+                            .surface_samples = (int)cli_flag_int(c, F_SAMPLES, TCB_DEFAULT_SURFACE_SAMPLES),
+                            .out_path = out};
     tcb_error err = {0};
-    return tcb_calibrate(&o, stdout, &err) ? cli_fail(&err) : 0;
+    if (!c->n_args) return tcb_calibrate(&o, stdout, &err) ? cli_fail(&err) : 0;
+    tcb_config cfg;
+    if (tcb_config_load(c->arg[0], &cfg, &err)) return cli_fail(&err);
+    rc = calibrate_on_config(&cfg, &o, &err);
+    tcb_config_free(&cfg);
+    return rc ? cli_fail(&err) : 0;
 }
 
 const cli_command cli_calibrate = {
-    .name = "calibrate", .fn = cmd_calibrate, .min_args = 0, .max_args = 0, .arg_names = "",
+    .name = "calibrate", .fn = cmd_calibrate, .min_args = 0, .max_args = 1, .arg_names = "[CONFIG]",
     .accepts = BIT(F_QUICK) | BIT(F_THREADS) | BIT(F_ONLY) | BIT(F_PRESET) | BIT(F_BUDGET) | BIT(F_SAMPLES) |
         BIT(F_OUT),
     .summary = "measure step and evaluation costs on this machine for the dry run's estimates",
     .usage =
         "usage: tcbench calibrate [--quick] [--threads T,T,...] [--only METHOD] [--preset NAME]\n"
-        "                         [--budget SECONDS] [--samples N] [--out FILE]\n"
+        "                         [--budget SECONDS] [--samples N] [--out FILE] [CONFIG]\n"
         "\n"
         "Measures on this machine what 'tcbench run --dry-run' prices cells with: a training\n"
         "step of every trained method at each of its presets, the method's part of an\n"
@@ -69,6 +115,13 @@ const cli_command cli_calibrate = {
         "machine's description (CPU, cores, library versions). Each measurement is a warm-up\n"
         "step, then steps while its share of the budget lasts (at least one: the largest\n"
         "presets may overrun a small budget, which the last line says); a unit likewise.\n"
+        "\n"
+        "With a CONFIG, only the units of its methods, measured on each of its sequences (the\n"
+        "budget shared between them) and written as costs of that sequence: the dry run prices\n"
+        "that sequence's units with them over the calibration sequence's, which it scales by\n"
+        "the vertex count only (a registration on a long, thin shape costs more per point: on\n"
+        "crane twice the calibration sequence's). Steps and evaluation pairs do not depend on\n"
+        "the sequence beyond its counts and are not measured again.\n"
         "\n"
         "The dry run reads, first match wins: <run dir>/calibration.json (a calibration made\n"
         "on the nodes that run it: --out RUN_DIR/calibration.json in a job there), the user's\n"
@@ -91,4 +144,5 @@ const cli_command cli_calibrate = {
         "examples:\n"
         "  tcbench calibrate --quick\n"
         "  tcbench calibrate --only dsr --preset paper --threads 1,2,4,8\n"
+        "  tcbench calibrate --only nricp --threads 1 --budget 120 configs/crane.json\n"
 };

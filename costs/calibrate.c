@@ -11,7 +11,14 @@
  * with a surface the reconstruction metrics of frames while their part
  * lasts, at least one; each unit is an untimed run, then runs while its
  * part lasts, at least one. A measurement whose warm-ups and single runs
- * exceed its share overruns the budget, which the closing line says. */
+ * exceed its share overruns the budget, which the closing line says.
+ *
+ * On a config's sequence (o->methods set) only the units of the config's
+ * methods and the harness's scoring of a pair are measured, on that
+ * sequence: what they cost depends on the shape as much as on the counts
+ * the calibration sequence's costs are scaled by (docs/cluster.md); a
+ * training step does not (it draws the same number of points from any
+ * sequence). */
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -25,7 +32,10 @@
 
 enum {
     MAX_STEPS = 50, QUICK_MAX_STEPS = 5, EVAL_PAIRS = 6, QUICK_EVAL_PAIRS = 1,
-    MAX_UNIT_RUNS = 10, QUICK_UNIT_RUNS = 2, SURFACE_FRAMES = 3, QUICK_SURFACE_FRAMES = 1
+    MAX_UNIT_RUNS = 10, QUICK_UNIT_RUNS = 2, SURFACE_FRAMES = 3, QUICK_SURFACE_FRAMES = 1,
+    /* a config's sequence's scoring: its cost varies with the pair (how far
+     * the no-model prediction lies from the truth), so more of them */
+    SEQUENCE_SCORE_PAIRS = 32, QUICK_SEQUENCE_SCORE_PAIRS = 8
 };
 
 typedef struct measurement {
@@ -67,6 +77,18 @@ static int plan_method(const tcb_calibrate_opts *o, const tcb_method_ops *ops, m
     return found;
 }
 
+/* Whether ops is measured: it has costs to measure (on a config's
+ * sequence: units, and it is one of the config's methods), and --only
+ * names it or nothing. */
+static int measured(const tcb_calibrate_opts *o, const tcb_method_ops *ops)
+{
+    if (o->method && strcmp(o->method, ops->name)) return 0;
+    if (!o->methods) return has_steps(ops) || n_units(ops);
+    int listed = o->n_methods == 0;
+    for (int k = 0; k < o->n_methods && !listed; k++) listed = !strcmp(o->methods[k], ops->name);
+    return listed && n_units(ops);
+}
+
 /* The measurements, in registry order; with m NULL only counted into *n.
  * --only or --preset naming nothing measurable is bad input. */
 static int plan(const tcb_calibrate_opts *o, measurement *m, int *n, tcb_error *err)
@@ -74,10 +96,13 @@ static int plan(const tcb_calibrate_opts *o, measurement *m, int *n, tcb_error *
     int methods = 0, presets = 0, counted = 0;
     for (int k = 0; k < tcb_registry_count(); k++) {
         const tcb_method_ops *ops = tcb_registry_get(k);
-        if (!(has_steps(ops) || n_units(ops)) || (o->method && strcmp(o->method, ops->name))) continue;
+        if (!measured(o, ops)) continue;
         methods++;
         presets += plan_method(o, ops, m, &counted);
     }
+    if (o->methods && !methods && o->method)
+        return tcb_fail(err, TCB_ERR_INPUT, "calibrate: --only %s: not a method of the config with units to measure "
+                        "on its sequences", o->method);
     if (o->method && !methods)
         return tcb_fail(err, TCB_ERR_INPUT, "calibrate: --only %s: no method of that name has costs to measure "
                         "(training steps or units)", o->method);
@@ -101,7 +126,7 @@ typedef struct session {
 
 static int add(tcb_calibration *cal, tcb_cost_kind kind, const measurement *m, double s, int samples, tcb_error *err)
 {
-    tcb_cost_entry e = {kind, "", "", m->threads, samples, s, "", 0};
+    tcb_cost_entry e = {.kind = kind, .threads = m->threads, .samples = samples, .seconds = s};
     snprintf(e.method, sizeof e.method, "%s", m->ops->name);
     snprintf(e.preset, sizeof e.preset, "%s", m->preset);
     return tcb_calibration_add(cal, &e, err);
@@ -156,8 +181,13 @@ static int measure_unit(const session *s, const measurement *m, void *self, int 
     tcb_step_timing t;
     int rc = tcb_time_unit(m->ops, self, s->seq, &ctx, k, s->o->quick ? QUICK_UNIT_RUNS : MAX_UNIT_RUNS, budget_s, &t,
                            err);
-    if (!rc && !(rc = add(s->cal, TCB_COST_UNIT, m, t.step_s, t.steps, err)))
-        snprintf(s->cal->entries[s->cal->n - 1].unit, sizeof s->cal->entries[0].unit, "%s", m->ops->units[k]);
+    tcb_cost_entry *e = !rc && !(rc = add(s->cal, TCB_COST_UNIT, m, t.step_s, t.steps, err))
+                            ? &s->cal->entries[s->cal->n - 1] : NULL;
+    if (e) snprintf(e->unit, sizeof e->unit, "%s", m->ops->units[k]);
+    if (e && s->o->sequence) {
+        snprintf(e->sequence, sizeof e->sequence, "%s", s->o->sequence_name);
+        e->vertices = s->seq->n_verts;
+    }
     if (rc) tcb_error_prefix(err, "unit %s: ", m->ops->units[k]);
     else fprintf(s->out, " %s %.3g s", m->ops->units[k], t.step_s);
     return rc;
@@ -170,7 +200,8 @@ static int measure(const session *s, const measurement *m, int t_index, double s
     void *self;
     int rc = m->ops->create(params, &self, err);
     if (rc) return rc;
-    int units = n_units(m->ops), steps = has_steps(m->ops), surface = steps && surface_measured(s, m);
+    int units = n_units(m->ops), steps = has_steps(m->ops) && !s->o->sequence;
+    int surface = steps && surface_measured(s, m);
     double part = 0.8 * share / (steps + surface + units);
     if (steps) rc = measure_steps(s, m, self, t_index, part, err);
     if (!rc && surface) rc = measure_surface(s, m, self, part, err);
@@ -185,6 +216,22 @@ static int thread_index(const tcb_calibrate_opts *o, int threads)
     int k = 0;
     while (o->threads[k] != threads) k++;
     return k;
+}
+
+/* The harness's scoring of pairs of a config's sequence at each thread
+ * count, with no method (the source frame's positions: what the nearest
+ * baseline predicts), into s->score_*. */
+static int measure_scoring(const session *s, tcb_error *err)
+{
+    int pairs = s->o->quick ? QUICK_SEQUENCE_SCORE_PAIRS : SEQUENCE_SCORE_PAIRS;
+    for (int t = 0; t < s->o->n_threads; t++) {
+        double method_s, score_s;
+        omp_set_num_threads(s->o->threads[t]);
+        int rc = tcb_time_eval_pairs(NULL, NULL, s->seq, pairs, &method_s, &score_s, err);
+        if (rc) return rc;
+        s->score_s[t] += score_s * pairs, s->score_n[t] += pairs;
+    }
+    return TCB_OK;
 }
 
 /* Every measurement, each announced before it starts. */
@@ -204,10 +251,14 @@ static int measure_all(const session *s, const measurement *m, int n, tcb_error 
             return rc;
         }
     }
+    int rc = s->o->sequence ? measure_scoring(s, err) : TCB_OK;
+    if (rc) return rc;
     for (int t = 0; t < s->o->n_threads; t++) {
-        tcb_cost_entry e = {TCB_COST_SCORE_PAIR, "", "", s->o->threads[t], s->score_n[t], 0, "", 0};
+        tcb_cost_entry e = {.kind = TCB_COST_SCORE_PAIR, .threads = s->o->threads[t], .samples = s->score_n[t]};
         e.seconds = s->score_n[t] ? s->score_s[t] / s->score_n[t] : 0;
-        int rc = s->score_n[t] ? tcb_calibration_add(s->cal, &e, err) : TCB_OK;
+        if (s->o->sequence) snprintf(e.sequence, sizeof e.sequence, "%s", s->o->sequence_name);
+        e.vertices = s->o->sequence ? s->seq->n_verts : 0;
+        rc = s->score_n[t] ? tcb_calibration_add(s->cal, &e, err) : TCB_OK;
         if (rc) return rc;
         if (s->score_n[t])
             fprintf(s->out, "scoring a pair (projection, metrics, geodesic error), %d thread%s: %.1f ms at %d vertices\n",
@@ -249,7 +300,7 @@ static int merge_earlier(const char *path, tcb_calibration *cal, FILE *out, tcb_
         for (int q = 0; q < measured && !again; q++) {
             const tcb_cost_entry *f = &cal->entries[q];
             again = f->kind == e->kind && f->threads == e->threads && !strcmp(f->method, e->method) &&
-                    !strcmp(f->preset, e->preset) && !strcmp(f->unit, e->unit);
+                    !strcmp(f->preset, e->preset) && !strcmp(f->unit, e->unit) && !strcmp(f->sequence, e->sequence);
         }
         if (!again) rc = tcb_calibration_add(cal, e, err);
     }
@@ -268,6 +319,12 @@ static int write_out(const tcb_calibrate_opts *o, tcb_calibration *cal, FILE *ou
     return rc;
 }
 
+int tcb_calibrate_check(const tcb_calibrate_opts *o, tcb_error *err)
+{
+    int n;
+    return plan(o, NULL, &n, err);
+}
+
 int tcb_calibrate(const tcb_calibrate_opts *o, FILE *out, tcb_error *err)
 {
     int n = 0;
@@ -279,17 +336,24 @@ int tcb_calibrate(const tcb_calibrate_opts *o, FILE *out, tcb_error *err)
     if (!rc) rc = plan(o, m, &n, err);
     tcb_sequence seq = {0};
     tcb_calibration cal = {0};
+    /* the file records the calibration sequence's counts, also when it
+     * holds a config's sequence's units: they are of the same machine */
     if (!rc) rc = tcb_calibration_sequence(&seq, err);
     if (!rc && !(cal.machine_json = tcb_machine_describe(cal.machine, sizeof cal.machine)))
         rc = tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
     if (!rc) {
         cal.n_verts = seq.n_verts, cal.n_frames = seq.n_frames;
-        fprintf(out, "calibrating on %s: %d measurements in a budget of %.0f s (%s)\n", cal.machine, n, o->budget_s,
-                o->quick ? "quick: coarse" : "a warm-up step, then steps while the budget lasts");
+        if (o->sequence)
+            fprintf(out, "calibrating on %s: %d measurements of units, and the scoring of pairs, on %s (%d frames, "
+                    "%d vertices) in a budget of %.0f s\n", cal.machine, n, o->sequence_name, o->sequence->n_frames, o->sequence->n_verts,
+                    o->budget_s);
+        else
+            fprintf(out, "calibrating on %s: %d measurements in a budget of %.0f s (%s)\n", cal.machine, n,
+                    o->budget_s, o->quick ? "quick: coarse" : "a warm-up step, then steps while the budget lasts");
     }
     int prev = omp_get_max_threads();
     double t0 = tcb_now_seconds();
-    session s = {o, &seq, &cal, score_s, score_n, out};
+    session s = {o, o->sequence ? o->sequence : &seq, &cal, score_s, score_n, out};
     if (!rc) rc = measure_all(&s, m, n, err);
     omp_set_num_threads(prev);
     double took = tcb_now_seconds() - t0;

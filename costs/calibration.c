@@ -6,9 +6,12 @@
  *  "costs": [{"kind": "step", "method": "cc", "preset": "paper", "threads": 2,
  *             "seconds": 2.9, "samples": 4},
  *            {"kind": "unit", "method": "nricp", "preset": "", "unit": "assign", ...},
+ *            {"kind": "unit", ..., "sequence": "ama/crane", "vertices": 10002},
  *            {"kind": "surface_frame", ..., "size": 100000},
  *            {"kind": "surface_mesh", ...}, ...]}
- * "unit" is there for kind unit only, "size" for surface_frame only;
+ * "unit" is there for kind unit only, "size" for surface_frame only,
+ * "sequence" and "vertices" for a unit or a pair's scoring measured on a
+ * config's sequence;
  * "frames" may be absent (files older than it: TCB_CALIBRATION_FRAMES). */
 #include <stdlib.h>
 #include <string.h>
@@ -54,12 +57,37 @@ static int copy_str(const cJSON *o, const char *key, const char *where, char *ou
     return rc;
 }
 
-/* The keys only some kinds have: a unit's name, a surface frame's samples. */
+/* The sequence a unit or a pair's scoring was measured on and its vertex
+ * count, both or neither. */
+static int parse_sequence(const cJSON *o, const char *where, tcb_cost_entry *e, tcb_error *err)
+{
+    int has_seq = cJSON_GetObjectItemCaseSensitive(o, "sequence") != NULL;
+    int has_verts = cJSON_GetObjectItemCaseSensitive(o, "vertices") != NULL;
+    if (has_seq != has_verts)
+        return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: a cost measured on a sequence has both \"sequence\" and "
+                        "\"vertices\"", where, has_seq ? "sequence" : "vertices");
+    long long nv = 0;
+    int rc = has_seq ? copy_str(o, "sequence", where, e->sequence, sizeof e->sequence, err) : TCB_OK;
+    if (!rc && has_seq) rc = tcb_json_int(o, "vertices", where, 1, 0, 1, 100000000, &nv, err);
+    e->vertices = (int)nv;
+    return rc;
+}
+
+/* The keys only some kinds have: a unit's name, a surface frame's
+ * samples, the sequence of a unit or a pair's scoring. */
 static int parse_kind_keys(const cJSON *o, const char *where, tcb_cost_entry *e, tcb_error *err)
 {
-    if (e->kind == TCB_COST_UNIT) return copy_str(o, "unit", where, e->unit, sizeof e->unit, err);
-    if (cJSON_GetObjectItemCaseSensitive(o, "unit"))
-        return tcb_fail(err, TCB_ERR_INPUT, "%s.unit: only a cost of kind \"unit\" has one", where);
+    if (e->kind == TCB_COST_UNIT || e->kind == TCB_COST_SCORE_PAIR) {
+        int rc = e->kind == TCB_COST_UNIT ? copy_str(o, "unit", where, e->unit, sizeof e->unit, err) : TCB_OK;
+        if (!rc && e->kind != TCB_COST_UNIT && cJSON_GetObjectItemCaseSensitive(o, "unit"))
+            rc = tcb_fail(err, TCB_ERR_INPUT, "%s.unit: only a cost of kind \"unit\" has one", where);
+        return rc ? rc : parse_sequence(o, where, e, err);
+    }
+    static const char *const keys[] = {"unit", "sequence", "vertices", NULL};
+    for (int k = 0; keys[k]; k++)
+        if (cJSON_GetObjectItemCaseSensitive(o, keys[k]))
+            return tcb_fail(err, TCB_ERR_INPUT, "%s.%s: only a cost of kind \"%s\" has one", where, keys[k],
+                            k ? "unit\" or \"score_pair" : "unit");
     long long size = 0;
     int surface = e->kind == TCB_COST_SURFACE_FRAME;
     if (!surface && cJSON_GetObjectItemCaseSensitive(o, "size"))
@@ -71,8 +99,8 @@ static int parse_kind_keys(const cJSON *o, const char *where, tcb_cost_entry *e,
 
 static int parse_entry(const cJSON *o, const char *where, tcb_calibration *c, tcb_error *err)
 {
-    static const char *const keys[] = {"kind", "method", "preset", "unit", "threads", "seconds", "samples", "size",
-                                       NULL};
+    static const char *const keys[] = {"kind",    "method", "preset", "unit",     "threads", "seconds",
+                                       "samples", "size",   "sequence", "vertices", NULL};
     tcb_cost_entry e = {0};
     int kind = 0;
     long long threads = 0, samples = 0;
@@ -160,6 +188,8 @@ static cJSON *entry_json(const tcb_cost_entry *e)
     cJSON_AddNumberToObject(o, "seconds", significant(e->seconds));
     cJSON_AddNumberToObject(o, "samples", e->samples);
     if (e->kind == TCB_COST_SURFACE_FRAME) cJSON_AddNumberToObject(o, "size", e->size);
+    if (e->sequence[0]) cJSON_AddStringToObject(o, "sequence", e->sequence);
+    if (e->sequence[0]) cJSON_AddNumberToObject(o, "vertices", e->vertices);
     return o;
 }
 

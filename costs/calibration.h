@@ -17,6 +17,10 @@
  *     (kind score_pair, no method),
  * each at the thread counts measured, on the calibration sequence
  * (tcb_calibration_sequence), whose vertex and frame counts it records.
+ * A unit may also be measured on a sequence of a config (`tcbench calibrate
+ * CONFIG`): such a cost names the sequence and its vertex count, and prices
+ * that sequence's cells only, over the calibration sequence's (a unit's
+ * cost is the shape's as much as its vertex count's: docs/cluster.md).
  *
  * The face of costs/ for the dry run (harness/plan.c) and the command line:
  * the file, the set a dry run reads, and pricing. Measuring is
@@ -38,6 +42,8 @@ typedef enum tcb_cost_kind {
 
 /* The calibration sequence's frames (tcb_calibration_sequence). */
 #define TCB_CALIBRATION_FRAMES 6
+/* A config's sequence a unit was measured on: "dataset/sequence". */
+#define TCB_COST_SEQUENCE_MAX 200
 
 typedef struct tcb_cost_entry {
     tcb_cost_kind kind;
@@ -47,6 +53,10 @@ typedef struct tcb_cost_entry {
     double seconds;              /* mean per step, pair, unit or frame */
     char unit[32];               /* kind unit: its name; else "" */
     int size;                    /* kind surface_frame: samples per mesh; else 0 */
+    /* kind unit: the config's sequence it was measured on, its vertex
+     * count; "" and 0: the calibration sequence */
+    char sequence[TCB_COST_SEQUENCE_MAX];
+    int vertices;
 } tcb_cost_entry;
 
 typedef struct tcb_calibration {
@@ -92,12 +102,14 @@ void tcb_calibration_set_free(tcb_calibration_set *s);
 typedef struct tcb_cost_price {
     double seconds;
     const tcb_calibration *from;
+    int vertices;       /* of the sequence it was measured on */
     int lo, hi;         /* the measured thread counts it derives from */
     int extrapolated;   /* threads outside [lo, hi] */
 } tcb_cost_price;
 typedef struct tcb_cost_key {
     tcb_cost_kind kind;
     const char *method, *preset, *unit; /* "" where the kind has none */
+    const char *sequence;               /* a unit's measured on this sequence; NULL or "": the calibration sequence's */
 } tcb_cost_key;
 int tcb_cost_lookup(const tcb_calibration_set *s, const tcb_cost_key *key, int threads, tcb_cost_price *out);
 
@@ -106,15 +118,17 @@ int tcb_cost_lookup(const tcb_calibration_set *s, const tcb_cost_key *key, int t
  * the calibration sequence's with step_frames) and eval_s from the pair
  * costs, scaled with the vertex count's ratio (a pair carries every
  * vertex); its unit uses (abi_version >= 6) are added at their counts,
- * scaled with the vertex count's ratio to the calibration sequence's to
- * their exponent; a method with a surface (surface_samples > 0: the
+ * each from its cost measured on `sequence` (the cell's "dataset/sequence")
+ * where a calibration has one, else the calibration sequence's, scaled
+ * with the vertex count's ratio to the measured sequence's to its
+ * exponent; a method with a surface (surface_samples > 0: the
  * config's samples per mesh) gets the reconstruction metrics of the frames
  * its pairs use added, or, not measured, a basis that says so; every
  * estimate with an eval_s gets the harness's scoring of q->n_pairs pairs
  * added, scaled with the square of the vertex count (the metrics compare
  * vertex with vertex; an upper bound). Unknown parts make fit_s and eval_s
  * -1, and basis says which command measures them. */
-void tcb_cost_price_cell(const tcb_calibration_set *s, const char *method, const tcb_cost_query *q,
-                         int surface_samples, tcb_cost_estimate *e);
+void tcb_cost_price_cell(const tcb_calibration_set *s, const char *method, const char *sequence,
+                         const tcb_cost_query *q, int surface_samples, tcb_cost_estimate *e);
 
 #endif

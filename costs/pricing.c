@@ -11,6 +11,7 @@
 typedef struct cost_curve {
     int n, threads[MAX_COUNTS];
     double seconds[MAX_COUNTS];
+    int vertices; /* of the sequence measured on */
 } cost_curve;
 
 /* The measurements of key in c by increasing thread count (a count
@@ -18,12 +19,14 @@ typedef struct cost_curve {
  * that counts measured at other sizes compare. */
 static void curve_of(const tcb_calibration *c, const tcb_cost_key *key, cost_curve *out)
 {
+    const char *sequence = key->sequence ? key->sequence : "";
     out->n = 0;
     for (int k = 0; k < c->n; k++) {
         const tcb_cost_entry *e = &c->entries[k];
         if (e->kind != key->kind || strcmp(e->method, key->method) || strcmp(e->preset, key->preset) ||
-            strcmp(e->unit, key->unit))
+            strcmp(e->unit, key->unit) || strcmp(e->sequence, sequence))
             continue;
+        out->vertices = e->sequence[0] ? e->vertices : c->n_verts;
         double seconds = e->size > 0 ? e->seconds / e->size : e->seconds;
         int at = 0;
         while (at < out->n && out->threads[at] < e->threads) at++;
@@ -73,6 +76,7 @@ int tcb_cost_lookup(const tcb_calibration_set *s, const tcb_cost_key *key, int t
         if (!c.n) continue;
         price_curve(&c, threads < 1 ? 1 : threads, out);
         out->from = &s->c[k];
+        out->vertices = c.vertices;
         return 0;
     }
     return -1;
@@ -101,13 +105,17 @@ static void data_absent(tcb_cost_estimate *e, const char *grows)
     snprintf(e->basis, sizeof e->basis, "grows with the %s (data absent)", grows);
 }
 
-/* The harness's scoring of q's pairs at q's vertex count; -1: unknown. */
-static double score_seconds(const tcb_calibration_set *s, const tcb_cost_query *q)
+/* The harness's scoring of q's pairs at q's vertex count, measured on the
+ * cell's sequence where a calibration has it (*own set); -1: unknown. */
+static double score_seconds(const tcb_calibration_set *s, const char *sequence, const tcb_cost_query *q, int *own)
 {
     tcb_cost_price p;
-    const tcb_cost_key key = {TCB_COST_SCORE_PAIR, "", "", ""};
-    if (q->n_verts < 1 || tcb_cost_lookup(s, &key, q->n_threads, &p)) return -1;
-    double r = (double)q->n_verts / p.from->n_verts;
+    const tcb_cost_key own_key = {TCB_COST_SCORE_PAIR, "", "", "", sequence};
+    const tcb_cost_key key = {TCB_COST_SCORE_PAIR, "", "", "", NULL};
+    if (q->n_verts < 1) return -1;
+    *own = sequence && sequence[0] && !tcb_cost_lookup(s, &own_key, q->n_threads, &p);
+    if (!*own && tcb_cost_lookup(s, &key, q->n_threads, &p)) return -1;
+    double r = (double)q->n_verts / p.vertices;
     return q->n_pairs * p.seconds * r * r;
 }
 
@@ -117,8 +125,8 @@ static int price_preset(const tcb_calibration_set *s, const char *method, const 
                         tcb_cost_estimate *e)
 {
     tcb_cost_price step, pair;
-    const tcb_cost_key step_key = {TCB_COST_STEP, method, e->preset, ""};
-    const tcb_cost_key pair_key = {TCB_COST_EVAL_PAIR, method, e->preset, ""};
+    const tcb_cost_key step_key = {TCB_COST_STEP, method, e->preset, "", NULL};
+    const tcb_cost_key pair_key = {TCB_COST_EVAL_PAIR, method, e->preset, "", NULL};
     if (tcb_cost_lookup(s, &step_key, q->n_threads, &step)) {
         unknown(e, "step cost", method, e->preset);
         return 0;
@@ -137,18 +145,24 @@ static int price_preset(const tcb_calibration_set *s, const char *method, const 
     threads_text(&step, q->n_threads, threads, sizeof threads);
     e->fit_s = (double)e->steps * step.seconds * frames;
     /* a pair carries every vertex of its source frame: linear in the count */
-    e->eval_s = q->n_pairs * pair.seconds * (q->n_verts > 0 ? (double)q->n_verts / pair.from->n_verts : 1);
+    e->eval_s = q->n_pairs * pair.seconds * (q->n_verts > 0 ? (double)q->n_verts / pair.vertices : 1);
     snprintf(e->basis, sizeof e->basis, "%lld steps x %.1f ms%s (%.60s, %.80s)", e->steps,
              step.seconds * frames * 1e3, e->step_frames ? " at its frames" : "", threads, step.from->machine);
     return 1;
 }
 
-/* One unit use's seconds into *fit, *eval; 0 when unknown (e says why). */
-static int price_unit(const tcb_calibration_set *s, const char *method, const tcb_cost_query *q, const tcb_unit_use *u,
-                      tcb_cost_estimate *e, double *fit, double *eval, tcb_cost_price *p)
+/* One unit use's seconds into *fit, *eval, from its cost measured on the
+ * cell's sequence where there is one (returns 2), else on the calibration
+ * sequence (1); 0 when unknown (e says why). */
+static int price_unit(const tcb_calibration_set *s, const char *method, const char *sequence,
+                      const tcb_cost_query *q, const tcb_unit_use *u, tcb_cost_estimate *e, double *fit, double *eval,
+                      tcb_cost_price *p)
 {
-    const tcb_cost_key key = {TCB_COST_UNIT, method, e->preset, u->unit};
-    if (tcb_cost_lookup(s, &key, u->threads > 0 ? u->threads : q->n_threads, p)) {
+    const tcb_cost_key own = {TCB_COST_UNIT, method, e->preset, u->unit, sequence};
+    const tcb_cost_key key = {TCB_COST_UNIT, method, e->preset, u->unit, NULL};
+    int threads = u->threads > 0 ? u->threads : q->n_threads;
+    int measured_on_it = sequence && sequence[0] && !tcb_cost_lookup(s, &own, threads, p);
+    if (!measured_on_it && tcb_cost_lookup(s, &key, threads, p)) {
         char what[64];
         snprintf(what, sizeof what, "unit %.31s", u->unit);
         unknown(e, what, method, e->preset);
@@ -158,17 +172,18 @@ static int price_unit(const tcb_calibration_set *s, const char *method, const tc
         data_absent(e, "vertex count");
         return 0;
     }
-    double each = p->seconds * (u->exponent != 0 ? pow((double)q->n_verts / p->from->n_verts, u->exponent) : 1);
+    double each = p->seconds * (u->exponent != 0 ? pow((double)q->n_verts / p->vertices, u->exponent) : 1);
     *fit = u->fit * each, *eval = u->eval * each;
-    return 1;
+    return measured_on_it ? 2 : 1;
 }
 
 /* The units' seconds added to fit_s and eval_s; the basis names the
- * costliest unit: after the steps' basis when there is one (which names
- * the machine), else after the method's own words with its threads and
- * machine. 0 when one is unknown. */
-static int price_units(const tcb_calibration_set *s, const char *method, const tcb_cost_query *q,
-                       tcb_cost_estimate *e)
+ * costliest unit (and the sequence it was measured on, when the cell's):
+ * after the steps' basis when there is one (which names the machine), else
+ * after the method's own words with its threads and machine. 0 when one is
+ * unknown. */
+static int price_units(const tcb_calibration_set *s, const char *method, const char *sequence,
+                       const tcb_cost_query *q, tcb_cost_estimate *e)
 {
     double most = -1;
     char costliest[192] = "";
@@ -177,7 +192,8 @@ static int price_units(const tcb_calibration_set *s, const char *method, const t
         const tcb_unit_use *u = &e->units[k];
         double fit, eval;
         tcb_cost_price p;
-        if (!price_unit(s, method, q, u, e, &fit, &eval, &p)) return 0;
+        int from = price_unit(s, method, sequence, q, u, e, &fit, &eval, &p);
+        if (!from) return 0;
         e->fit_s += fit, e->eval_s += eval;
         if (fit + eval <= most) continue;
         char threads[64];
@@ -188,6 +204,8 @@ static int price_units(const tcb_calibration_set *s, const char *method, const t
         int len = snprintf(costliest, sizeof costliest, count == floor(count) && count < 1e15 ? "%.0f %.31s x %.3g s"
                                                                                               : "%.4g %.31s x %.3g s",
                            count, u->unit, fit + eval > 0 ? (fit + eval) / count : 0.0);
+        if (from == 2 && len > 0 && (size_t)len < sizeof costliest)
+            len += snprintf(costliest + len, sizeof costliest - (size_t)len, " measured on %.60s", sequence);
         if (!after_steps && len > 0 && (size_t)len < sizeof costliest)
             snprintf(costliest + len, sizeof costliest - (size_t)len, " (%.40s, %.50s)", threads, p.from->machine);
     }
@@ -205,8 +223,8 @@ static double surface_seconds(const tcb_calibration_set *s, const char *method, 
                               const tcb_cost_query *q, int samples)
 {
     tcb_cost_price harness, mesh;
-    const tcb_cost_key frame_key = {TCB_COST_SURFACE_FRAME, method, preset, ""};
-    const tcb_cost_key mesh_key = {TCB_COST_SURFACE_MESH, method, preset, ""};
+    const tcb_cost_key frame_key = {TCB_COST_SURFACE_FRAME, method, preset, "", NULL};
+    const tcb_cost_key mesh_key = {TCB_COST_SURFACE_MESH, method, preset, "", NULL};
     if (tcb_cost_lookup(s, &frame_key, q->n_threads, &harness) || tcb_cost_lookup(s, &mesh_key, q->n_threads, &mesh))
         return -2;
     if (q->n_frames < 1) return -1;
@@ -228,14 +246,18 @@ static void add_surface(const tcb_calibration_set *s, const char *method, const 
     else e->eval_s = -1;
 }
 
-void tcb_cost_price_cell(const tcb_calibration_set *s, const char *method, const tcb_cost_query *q,
-                         int surface_samples, tcb_cost_estimate *e)
+void tcb_cost_price_cell(const tcb_calibration_set *s, const char *method, const char *sequence,
+                         const tcb_cost_query *q, int surface_samples, tcb_cost_estimate *e)
 {
     if (e->preset[0] && e->steps > 0 && !price_preset(s, method, q, e)) return;
-    if (e->n_units > 0 && !price_units(s, method, q, e)) return;
+    if (e->n_units > 0 && !price_units(s, method, sequence, q, e)) return;
     if (e->eval_s < 0) return;
     if (surface_samples > 0) add_surface(s, method, q, surface_samples, e);
     if (e->eval_s < 0) return;
-    double score = score_seconds(s, q);
+    int own = 0;
+    double score = score_seconds(s, sequence, q, &own);
     e->eval_s = score < 0 ? -1 : e->eval_s + score;
+    size_t len = strlen(e->basis);
+    if (own && len + 40 < sizeof e->basis)
+        snprintf(e->basis + len, sizeof e->basis - len, "; scoring measured on %s", sequence);
 }

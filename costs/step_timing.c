@@ -4,11 +4,13 @@
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "costs/calibration.h"
 #include "costs/step_timing.h"
 #include "scoring/scoring.h"
 #include "tcb/metrics.h"
+#include "tcb/rng.h"
 #include "tcb/synth.h"
 
 int tcb_calibration_sequence(tcb_sequence *s, tcb_error *err)
@@ -154,6 +156,10 @@ static int reconstruct_frame(const tcb_method_ops *ops, void *self, const tcb_se
 static int method_pair(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, int i, int j, float *moved,
                        double *method_s, tcb_error *err)
 {
+    if (!ops) { /* no method: the source frame's positions, as the nearest baseline carries them */
+        memcpy(moved, tcb_seq_frame(seq, i), (size_t)seq->n_verts * 3 * sizeof *moved);
+        return TCB_OK;
+    }
     tcb_rng rng;
     tcb_rng_seed_stream(&rng, 0, "calibrate/eval");
     double t0 = tcb_now_seconds();
@@ -173,9 +179,15 @@ int tcb_time_eval_pairs(const tcb_method_ops *ops, void *self, const tcb_sequenc
     tcb_pair_scorer scorer;
     int rc = moved && pred ? tcb_pair_scorer_init(&scorer, seq, err) : tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
     *method_s = *score_s = 0;
+    /* pairs drawn as a split draws them (an ordered pair of distinct frames,
+     * uniform): the scoring's geodesic search walks from each vertex's
+     * prediction to its truth, longer for frames further apart */
+    tcb_rng pairs;
+    tcb_rng_seed_stream(&pairs, 0, "calibrate/pairs");
     /* pair -1, untimed, sets up what a cell's evaluation sets up once */
     for (int k = -1; !rc && k < n; k++) {
-        int m = k + 1, i = m % seq->n_frames, j = (i + 1 + m / seq->n_frames) % seq->n_frames;
+        uint32_t f = (uint32_t)seq->n_frames, a = tcb_rng_below(&pairs, f);
+        int i = (int)a, j = (int)((a + 1 + tcb_rng_below(&pairs, f - 1)) % f);
         double before = *method_s;
         rc = method_pair(ops, self, seq, i, j, moved, method_s, err);
         tcb_pair_prediction p = {i, j, moved, pred, NAN, NULL};

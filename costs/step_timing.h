@@ -40,7 +40,8 @@ int tcb_time_surface_frames(const tcb_method_ops *ops, void *self, const tcb_seq
 
 /* Mean seconds per pair over n pairs of seq, after one untimed, of a
  * method trained by train_steps: its part (transfer, reconstructions and their Chamfer
- * distances) and the harness's scoring of its transfer. */
+ * distances) and the harness's scoring of its transfer. ops NULL: no
+ * method, the scoring of the source frame's positions (method_s 0). */
 int tcb_time_eval_pairs(const tcb_method_ops *ops, void *self, const tcb_sequence *seq, int n, double *method_s,
                         double *score_s, tcb_error *err);
 

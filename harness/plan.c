@@ -115,9 +115,12 @@ static int state_runs(const char *state)
            !strncmp(state, "stale", 5);
 }
 
-static void estimate_cell(const tcb_calibration_set *cals, const tcb_method_spec *m, const tcb_cost_query *q,
+static void estimate_cell(const tcb_calibration_set *cals, const tcb_grid_cell *c, const tcb_cost_query *q,
                           int surface_samples, tcb_cost_estimate *e)
 {
+    const tcb_method_spec *m = c->method;
+    char sequence[TCB_COST_SEQUENCE_MAX]; /* a unit measured on the cell's sequence prices its cells (costs/calibration.h) */
+    snprintf(sequence, sizeof sequence, "%s/%s", c->dataset->name, c->sequence->name);
     const tcb_method_ops *ops = tcb_registry_find(m->method); /* checked before */
     void *self = NULL;
     tcb_error err = {0};
@@ -127,7 +130,7 @@ static void estimate_cell(const tcb_calibration_set *cals, const tcb_method_spec
     if (ops->abi_version < 2 || !ops->estimate || ops->create(m->params_json, &self, &err)) return;
     ops->estimate(self, q, e);
     ops->destroy(self);
-    tcb_cost_price_cell(cals, ops->name, q, tcb_method_has_surface(ops) ? surface_samples : 0, e);
+    tcb_cost_price_cell(cals, ops->name, sequence, q, tcb_method_has_surface(ops) ? surface_samples : 0, e);
 }
 
 /* The wall time of the cells' seconds run as `tasks` concurrent one-cell
@@ -245,7 +248,7 @@ static int plan_cell(void *ctx, const tcb_grid_cell *c)
     cell_state(w->run_dir, w->opts, c->dataset, c->sequence->name, c->method, c->seed, state, sizeof state);
     int runs = w->opts->force || state_runs(state);
     tcb_cost_estimate e;
-    estimate_cell(w->cals, c->method, &w->q, w->cfg->surface_samples, &e);
+    estimate_cell(w->cals, c, &w->q, w->cfg->surface_samples, &e);
     if (runs) price_from_sibling(w, c, &e);
     char fit[32], eval[32];
     duration_text(e.fit_s, fit, sizeof fit);

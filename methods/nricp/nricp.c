@@ -21,6 +21,7 @@
 #include "methods/nricp/nricp_internal.h"
 #include "methods/params.h"
 #include "tcb/json.h"
+#include "tcb/rng.h"
 
 #define WHERE "nricp.params"
 
@@ -48,6 +49,7 @@ static int nricp_create(const char *params_json, void **self, tcb_error *err)
     m->strategy = (nricp_strategy)strategy;
     m->params = p;
     m->params.rounds = (int)rounds, m->params.smooth = (int)smooth, m->params.smooth_last = (int)smooth_last;
+    tcb_rng_seed_stream(&m->unit_pairs, 0, "nricp unit pairs");
     *self = m;
     return TCB_OK;
 }
@@ -137,12 +139,13 @@ static int nricp_transfer(void *self, const tcb_sequence *seq, int i, int j, con
 
 /* The costs `tcbench calibrate` measures (tcb_method_ops.units), with the
  * default params, on its sequence: a registration between the frames of
- * a random pair (frames 0 and F/2: a random pair's frames lie F/3 apart
- * on average, further than consecutive ones, and registrations between
+ * a random pair (drawn as a split draws them: registrations between
  * frames further apart take longer), one between consecutive frames (a
  * propagating map's; a deform chain's step, which starts from the
  * deformed previous frame, is priced as one), and the dense assignment of
- * a frame's vertices to the next's (propagate_bijective's matching). */
+ * a frame's vertices to the next's (propagate_bijective's matching). Each
+ * run draws its frames anew (seeded at create), so that a unit's runs
+ * average over the sequence's pairs, as a cell's pairs do. */
 static const char *const unit_names[] = {"register_random", "register_neighbor", "assign", NULL};
 enum { UNIT_RANDOM, UNIT_NEIGHBOR, UNIT_ASSIGN };
 /* A registration costs about its points x rounds (the old typed-in model,
@@ -157,13 +160,16 @@ static int nricp_run_unit(void *self, const tcb_sequence *seq, const tcb_fit_ctx
     nricp_method *m = self;
     int rc = m->normals && m->n_frames == seq->n_frames && m->n_verts == seq->n_verts ? TCB_OK
                                                                                       : nricp_prepare(m, seq, err);
-    int nv = seq->n_verts, b = unit == UNIT_RANDOM ? seq->n_frames / 2 : 1;
+    /* random: an ordered pair of distinct frames, uniform; else a frame and the next */
+    uint32_t f = (uint32_t)seq->n_frames, a = tcb_rng_below(&m->unit_pairs, unit == UNIT_RANDOM ? f : f - 1);
+    uint32_t b = unit == UNIT_RANDOM ? (a + 1 + tcb_rng_below(&m->unit_pairs, f - 1)) % f : a + 1;
+    int nv = seq->n_verts;
     float *out = rc ? NULL : malloc((size_t)nv * 3 * sizeof *out);
     int32_t *map = rc ? NULL : malloc((size_t)nv * sizeof *map);
     if (!rc && (!out || !map)) rc = tcb_fail(err, TCB_ERR_NOMEM, "nricp: out of memory");
-    if (!rc && unit == UNIT_ASSIGN) rc = nricp_assign(tcb_seq_frame(seq, 0), tcb_seq_frame(seq, 1), nv, map, err);
+    if (!rc && unit == UNIT_ASSIGN) rc = nricp_assign(tcb_seq_frame(seq, a), tcb_seq_frame(seq, b), nv, map, err);
     else if (!rc)
-        rc = nricp_register(tcb_seq_frame(seq, 0), nricp_normals_of(m, 0), nv, tcb_seq_frame(seq, b),
+        rc = nricp_register(tcb_seq_frame(seq, a), nricp_normals_of(m, a), nv, tcb_seq_frame(seq, b),
                             nricp_normals_of(m, b), nv, &m->params, out, err);
     free(out), free(map);
     return rc;

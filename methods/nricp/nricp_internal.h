@@ -8,6 +8,7 @@
 
 #include "methods/nricp/register.h"
 #include "tcb/method.h"
+#include "tcb/rng.h"
 
 /* Reference-protocol §6.3; TCSR's names in parentheses in nricp.c. */
 typedef enum nricp_strategy {
@@ -56,6 +57,7 @@ typedef struct nricp_method {
      * (n = 0 before, and for the other strategies). */
     nricp_chains chains;
     nricp_ahead ahead; /* random only (else empty) */
+    tcb_rng unit_pairs; /* the frames of run_unit's registrations (nricp.c) */
 } nricp_method;
 
 static inline int nricp_uses_maps(nricp_strategy s)

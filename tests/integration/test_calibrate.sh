@@ -190,3 +190,35 @@ for t in 1 2; do
           cat out.txt; exit 1; }
 done
 echo "ok"
+
+# A config's sequences (`calibrate CONFIG`): the units of its methods and
+# the scoring of a pair measured on each of its sequences, written as costs
+# of that sequence, price that sequence's cells over the calibration
+# sequence's, and no other sequence's.
+cat > walk.json <<'JSON'
+{ "name": "walk", "output": "seq", "seeds": [0], "threads": 1, "evaluation": { "pairs": 24 },
+  "datasets": [ { "name": "s", "source": "synthetic", "frames": 10,
+                  "sequences": [ { "name": "quadruped_walk", "role": "test" } ] } ],
+  "methods": [ { "name": "nricp", "params": { "strategy": "random" } }, { "name": "nearest" } ] }
+JSON
+sed 's/"quadruped_walk", "role": "test" }/&, { "name": "quadruped_trot", "role": "test" }/' walk.json > both.json
+expect 0 "nricp             1 thread  register_random" "$TCBENCH" calibrate --quick --threads 1 --budget 4 \
+    --out seq/calibration.json walk.json
+grep -q "units, and the scoring of pairs, on s/quadruped_walk (10 frames" out.txt || { cat out.txt; exit 1; }
+expect 0 "costs from (first match wins): seq/calibration.json" "$TCBENCH" run both.json --dry-run
+/usr/bin/python3 - <<'PY'
+import json, re
+c = json.load(open("seq/calibration.json"))
+on = {(e["kind"], e.get("unit", "")) for e in c["costs"] if e.get("sequence") == "s/quadruped_walk"}
+assert on == {("unit", "register_random"), ("unit", "register_neighbor"), ("unit", "assign"), ("score_pair", "")}, on
+assert all(e["vertices"] > 0 for e in c["costs"] if "sequence" in e), c["costs"]
+text = open("out.txt").read()
+rows = dict(re.findall(r"(?m)^\s+(\d+)\s+\S+\s+0\s+missing\s+.*?  (\S.*)$", text))
+assert len(rows) == 4, text
+# walk: nricp 0, nearest 1; trot: nricp 2, nearest 3
+assert "register_random x" in rows["0"] and "measured on s/quadruped_walk" in rows["0"], rows["0"]
+assert rows["1"].endswith("scoring measured on s/quadruped_walk"), rows["1"]
+assert "measured on" not in rows["2"] + rows["3"], (rows["2"], rows["3"])
+PY
+expect 2 "calibrate: --only atlasnet: not a method of the config with units to measure on its sequences" \
+    "$TCBENCH" calibrate --quick --threads 1 --only atlasnet --out seq/other.json walk.json

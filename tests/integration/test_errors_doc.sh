@@ -414,11 +414,14 @@ cal '{"kind": "step", "method": "cc", "preset": "tiny", "unit": "assign", "threa
 row "a unit's name on a cost of another kind" run split.json --out runs/cal --dry-run
 cal '{"kind": "surface_frame", "method": "atlasnet", "preset": "tiny", "threads": 1, "seconds": 1, "samples": 1}'
 row "a surface frame's cost without its samples per mesh" run split.json --out runs/cal --dry-run
+cal '{"kind": "unit", "method": "nricp", "preset": "", "unit": "assign", "threads": 1, "seconds": 1, "samples": 1, "sequence": "s/w"}'
+row "a unit measured on a sequence without its vertex count" run split.json --out runs/cal --dry-run
 printf '{"format": "tcbench-calibration 1", "sequence": {"vertices": 9}, "costs": []}' > runs/cal/calibration.json
 row "no machine" run split.json --out runs/cal --dry-run
 row "\`--only\` a method with nothing to measure" "$TCBENCH" calibrate --only nearest --out c.json
 row "\`--preset\` none of the method's" "$TCBENCH" calibrate --only cc --preset huge --out c.json
 row "\`--threads\` not a list of counts" "$TCBENCH" calibrate --threads 1,,2 --out c.json
+row "\`--only\` a method the config has not, with a config" "$TCBENCH" calibrate --only nricp --out c.json split.json
 row "\`run --tasks\` without \`--dry-run\`" run split.json --tasks 2
 
 # ---- plug-ins

@@ -3,8 +3,9 @@
  * with the last two's scaling clamped to [linear, flat]), the first
  * calibration that measured a method wins, a cell priced from them (steps,
  * steps over every frame, units scaled with the vertex count, the
- * reconstruction metrics of the frames used), the file written and read
- * back, and malformed files named. */
+ * reconstruction metrics of the frames used; a config's sequence's units
+ * and scoring for that sequence only), the file written and read back,
+ * and malformed files named. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -22,7 +23,7 @@
 static void add_sized(tcb_calibration *c, tcb_cost_kind kind, const char *method, const char *preset,
                       const char *unit, int size, int threads, double s)
 {
-    tcb_cost_entry e = {kind, "", "", threads, 1, s, "", size};
+    tcb_cost_entry e = {.kind = kind, .threads = threads, .samples = 1, .seconds = s, .size = size};
     snprintf(e.method, sizeof e.method, "%s", method);
     snprintf(e.preset, sizeof e.preset, "%s", preset);
     snprintf(e.unit, sizeof e.unit, "%s", unit);
@@ -39,7 +40,7 @@ static void add(tcb_calibration *c, tcb_cost_kind kind, const char *method, cons
 static int lookup(const tcb_calibration_set *s, tcb_cost_kind kind, const char *method, const char *preset,
                   int threads, tcb_cost_price *p)
 {
-    const tcb_cost_key key = {kind, method, preset, ""};
+    const tcb_cost_key key = {kind, method, preset, "", NULL};
     return tcb_cost_lookup(s, &key, threads, p);
 }
 
@@ -74,7 +75,7 @@ static tcb_cost_estimate of_preset(const char *preset, long long steps)
 static void assert_unknown(const tcb_calibration_set *s, const char *method, const tcb_cost_query *q,
                            tcb_cost_estimate e, const char *why)
 {
-    tcb_cost_price_cell(s, method, q, 0, &e);
+    tcb_cost_price_cell(s, method, NULL, q, 0, &e);
     assert_true(e.fit_s < 0 && e.eval_s < 0);
     if (!strstr(e.basis, why)) fail_msg("'%s' lacks '%s'", e.basis, why);
 }
@@ -145,7 +146,7 @@ static void test_price_cell(void **state)
     priced(&s);
     tcb_cost_query q = {10, 2000, 100, 1};
     tcb_cost_estimate e = of_preset("p", 1000);
-    tcb_cost_price_cell(&s, "m", &q, 0, &e);
+    tcb_cost_price_cell(&s, "m", NULL, &q, 0, &e);
     assert_near(e.fit_s, 8000, 1e-9);
     /* 100 pairs x (0.25 x 2000/1000 + 0.01 x (2000/1000)^2): the method's
      * part linear in the vertex count, the scoring's quadratic */
@@ -153,7 +154,7 @@ static void test_price_cell(void **state)
     assert_non_null(strstr(e.basis, "1000 steps x 8000.0 ms (1 thread, first)"));
     /* a method naming no preset keeps its own fit and gets the scoring added */
     tcb_cost_estimate own = {.fit_s = 3, .eval_s = 1};
-    tcb_cost_price_cell(&s, "x", &q, 0, &own);
+    tcb_cost_price_cell(&s, "x", NULL, &q, 0, &own);
     assert_near(own.fit_s, 3, 0);
     assert_near(own.eval_s, 1 + 100 * 0.04, 1e-9);
     /* a preset not measured: unknown, with the command that measures it */
@@ -173,7 +174,7 @@ static void test_price_epochs_and_unit(void **state)
     tcb_cost_estimate e = of_preset("p", 10);
     e.step_frames = 1, e.n_units = 1;
     e.units[0] = (tcb_unit_use){"template", 1, 0, 0, 0};
-    tcb_cost_price_cell(&s, "m", &q, 0, &e);
+    tcb_cost_price_cell(&s, "m", NULL, &q, 0, &e);
     assert_near(e.fit_s, 10 * 8 * 2 + 3, 1e-9);
     assert_near(e.eval_s, 4 * (0.25 + 0.01), 1e-9);
     assert_non_null(strstr(e.basis, "10 steps x 16000.0 ms at its frames (1 thread, first) + 1 template x 3 s"));
@@ -201,7 +202,7 @@ static void test_price_units(void **state)
     snprintf(e.basis, sizeof e.basis, "random");
     e.units[0] = (tcb_unit_use){"register_random", 0, 100, 1, 1};
     e.units[1] = (tcb_unit_use){"assign", 9, 0, 2.3, 1};
-    tcb_cost_price_cell(&s, "r", &q, 0, &e);
+    tcb_cost_price_cell(&s, "r", NULL, &q, 0, &e);
     /* 9 x 0.5 s x 2^2.3 = 22.16 s; 100 x 2 s x 2 (the one-thread cost) plus the scoring, 100 x 0.01 x 2^2 */
     assert_near(e.fit_s, 9 * 0.5 * 4.924577653379665, 1e-9);
     assert_near(e.eval_s, 100 * 2.0 * 2 + 4, 1e-9);
@@ -210,13 +211,53 @@ static void test_price_units(void **state)
     tcb_cost_estimate none = {.n_units = 1};
     none.units[0] = (tcb_unit_use){"register_neighbor", 1, 0, 1, 1};
     assert_unknown(&s, "r", &q, none, "no unit register_neighbor of r measured: tcbench calibrate --only r");
-    tcb_cost_price_cell(&s, "r", &q, 0, &none);
+    tcb_cost_price_cell(&s, "r", NULL, &q, 0, &none);
     assert_null(strstr(none.basis, "--preset"));
     /* a unit growing with the vertex count, the data absent */
     tcb_cost_query absent = {0, 0, 100, 2};
     tcb_cost_estimate a = {.n_units = 1};
     a.units[0] = e.units[0];
     assert_unknown(&s, "r", &absent, a, "grows with the vertex count");
+    tcb_calibration_set_free(&s);
+}
+
+/* e (kind unit or score_pair, added last to c) measured on `sequence` of nv vertices. */
+static void on_sequence(tcb_calibration *c, const char *sequence, int nv)
+{
+    snprintf(c->entries[c->n - 1].sequence, sizeof c->entries[0].sequence, "%s", sequence);
+    c->entries[c->n - 1].vertices = nv;
+}
+
+/* Units and the scoring measured on a config's sequence price that
+ * sequence's cells (scaled from its own vertex count) over the calibration
+ * sequence's, and only that sequence's; the basis says so. */
+static void test_price_on_sequence(void **state)
+{
+    (void)state;
+    tcb_calibration_set s;
+    one(&s);
+    add(&s.c[0], TCB_COST_SCORE_PAIR, "", "", 1, 0.01);
+    add_sized(&s.c[0], TCB_COST_UNIT, "r", "", "register_random", 0, 1, 2.0);
+    /* crane-like: 4 s a registration at 4000 vertices, 0.3 s a pair's scoring */
+    add_sized(&s.c[0], TCB_COST_UNIT, "r", "", "register_random", 0, 1, 4.0);
+    on_sequence(&s.c[0], "d/long", 4000);
+    add(&s.c[0], TCB_COST_SCORE_PAIR, "", "", 1, 0.3);
+    on_sequence(&s.c[0], "d/long", 4000);
+    tcb_cost_query q = {10, 2000, 100, 1};
+    tcb_cost_estimate e = {.n_units = 1};
+    snprintf(e.basis, sizeof e.basis, "random");
+    e.units[0] = (tcb_unit_use){"register_random", 0, 100, 1, 1};
+    tcb_cost_estimate other = e;
+    tcb_cost_price_cell(&s, "r", "d/long", &q, 0, &e);
+    /* 100 x 4 s x 2000/4000, and 100 x 0.3 s x (2000/4000)^2 */
+    assert_near(e.eval_s, 100 * 4.0 * 0.5 + 100 * 0.3 * 0.25, 1e-9);
+    if (!strstr(e.basis, "random: 100 register_random x 2 s measured on d/long (1 thread, first); scoring measured "
+                         "on d/long"))
+        fail_msg("'%s'", e.basis);
+    /* another sequence: the calibration sequence's costs, from its 1000 vertices */
+    tcb_cost_price_cell(&s, "r", "d/short", &q, 0, &other);
+    assert_near(other.eval_s, 100 * 2.0 * 2 + 100 * 0.01 * 4, 1e-9);
+    assert_null(strstr(other.basis, "measured on"));
     tcb_calibration_set_free(&s);
 }
 
@@ -233,14 +274,14 @@ static void test_price_surface(void **state)
     add(&s.c[0], TCB_COST_SURFACE_MESH, "m", "p", 1, 0.5);
     tcb_cost_query q = {2, 1000, 1, 1};
     tcb_cost_estimate e = of_preset("p", 1);
-    tcb_cost_price_cell(&s, "m", &q, 500, &e);
+    tcb_cost_price_cell(&s, "m", NULL, &q, 500, &e);
     /* each frame: its mesh, 0.5 s, and the harness's part at half the samples */
     assert_near(e.eval_s, 0.25 + 1.5 * (0.5 + 2.0 * 500 / 1000) + 0.01, 1e-9);
     /* not measured (another preset): the evaluation without them, and said */
     add(&s.c[0], TCB_COST_STEP, "m", "p2", 1, 1);
     add(&s.c[0], TCB_COST_EVAL_PAIR, "m", "p2", 1, 0.25);
     tcb_cost_estimate o = of_preset("p2", 1);
-    tcb_cost_price_cell(&s, "m", &q, 500, &o);
+    tcb_cost_price_cell(&s, "m", NULL, &q, 500, &o);
     assert_near(o.eval_s, 0.25 + 0.01, 1e-9);
     assert_non_null(strstr(o.basis, "reconstruction metrics not measured: tcbench calibrate --only m --preset p2"));
     tcb_calibration_set_free(&s);
@@ -257,6 +298,8 @@ static void test_file_round_trip(void **state)
     add(&c, TCB_COST_SCORE_PAIR, "", "", 1, 0.0101);
     add_sized(&c, TCB_COST_UNIT, "nricp", "", "assign", 0, 1, 0.5);
     add_sized(&c, TCB_COST_SURFACE_FRAME, "atlasnet", "cpu", "", 100000, 2, 1.25);
+    add_sized(&c, TCB_COST_UNIT, "nricp", "", "register_random", 0, 1, 0.55);
+    on_sequence(&c, "ama/crane", 10002);
     char path[1024];
     snprintf(path, sizeof path, "%s/cal.json", dir);
     tcb_error err = {0};
@@ -274,7 +317,7 @@ static void test_file_round_trip(void **state)
     assert_string_equal(s.c[0].machine, "CPU, 2 cores");
     assert_int_equal(s.c[0].n_verts, 2688);
     assert_int_equal(s.c[0].n_frames, 6);
-    assert_int_equal(s.c[0].n, 4);
+    assert_int_equal(s.c[0].n, 5);
     assert_near(s.c[0].entries[0].seconds, 2.912, 1e-12); /* 4 significant digits */
     assert_int_equal(s.c[0].entries[1].kind, TCB_COST_SCORE_PAIR);
     assert_int_equal(s.c[0].entries[2].kind, TCB_COST_UNIT);
@@ -282,6 +325,9 @@ static void test_file_round_trip(void **state)
     assert_int_equal(s.c[0].entries[3].kind, TCB_COST_SURFACE_FRAME);
     assert_int_equal(s.c[0].entries[3].size, 100000);
     assert_string_equal(s.c[0].entries[3].unit, "");
+    assert_string_equal(s.c[0].entries[3].sequence, "");
+    assert_string_equal(s.c[0].entries[4].sequence, "ama/crane");
+    assert_int_equal(s.c[0].entries[4].vertices, 10002);
     tcb_calibration_set_free(&s);
 }
 
@@ -317,6 +363,14 @@ static void test_malformed(void **state)
         {"{\"format\": \"tcbench-calibration 1\", \"machine\": {\"summary\": \"m\"}, \"sequence\": {\"vertices\": 9,"
          " \"frames\": 0}, \"costs\": []}",
          "f.json: sequence.frames"},
+        {"{\"format\": \"tcbench-calibration 1\", \"machine\": {\"summary\": \"m\"}, \"sequence\": {\"vertices\": 9},"
+         " \"costs\": [{\"kind\": \"unit\", \"method\": \"a\", \"preset\": \"\", \"unit\": \"u\", \"threads\": 1,"
+         " \"seconds\": 1, \"samples\": 1, \"sequence\": \"d/s\"}]}",
+         "f.json: costs[0].sequence: a cost measured on a sequence has both \"sequence\" and \"vertices\""},
+        {"{\"format\": \"tcbench-calibration 1\", \"machine\": {\"summary\": \"m\"}, \"sequence\": {\"vertices\": 9},"
+         " \"costs\": [{\"kind\": \"step\", \"method\": \"a\", \"preset\": \"p\", \"threads\": 1, \"seconds\": 1,"
+         " \"samples\": 1, \"sequence\": \"d/s\", \"vertices\": 9}]}",
+         "f.json: costs[0].sequence: only a cost of kind \"unit\" or \"score_pair\" has one"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         tcb_calibration c;
@@ -334,6 +388,7 @@ int main(void)
         cmocka_unit_test(test_price_cell),
         cmocka_unit_test(test_price_epochs_and_unit),
         cmocka_unit_test(test_price_units),
+        cmocka_unit_test(test_price_on_sequence),
         cmocka_unit_test(test_price_surface),
         cmocka_unit_test_setup_teardown(test_file_round_trip, tu_setup_tmpdir, tu_teardown_tmpdir),
         cmocka_unit_test(test_malformed),
