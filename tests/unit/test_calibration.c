@@ -221,9 +221,12 @@ static void test_price_units(void **state)
     tcb_calibration_set_free(&s);
 }
 
-/* e (kind unit or score_pair, added last to c) measured on `sequence` of nv vertices. */
-static void on_sequence(tcb_calibration *c, const char *sequence, int nv)
+/* A one-thread cost of method's unit (kind unit) or of a pair's scoring
+ * (unit NULL) measured on `sequence` of nv vertices. */
+static void add_on(tcb_calibration *c, const char *method, const char *unit, double s, const char *sequence, int nv)
 {
+    if (unit) add_sized(c, TCB_COST_UNIT, method, "", unit, 0, 1, s);
+    else add(c, TCB_COST_SCORE_PAIR, "", "", 1, s);
     snprintf(c->entries[c->n - 1].sequence, sizeof c->entries[0].sequence, "%s", sequence);
     c->entries[c->n - 1].vertices = nv;
 }
@@ -236,13 +239,12 @@ static void test_price_on_sequence(void **state)
     (void)state;
     tcb_calibration_set s;
     one(&s);
-    add(&s.c[0], TCB_COST_SCORE_PAIR, "", "", 1, 0.01);
-    add_sized(&s.c[0], TCB_COST_UNIT, "r", "", "register_random", 0, 1, 2.0);
-    /* crane-like: 4 s a registration at 4000 vertices, 0.3 s a pair's scoring */
-    add_sized(&s.c[0], TCB_COST_UNIT, "r", "", "register_random", 0, 1, 4.0);
-    on_sequence(&s.c[0], "d/long", 4000);
-    add(&s.c[0], TCB_COST_SCORE_PAIR, "", "", 1, 0.3);
-    on_sequence(&s.c[0], "d/long", 4000);
+    /* the calibration sequence's (1000 vertices), then crane-like ones: 4 s
+     * a registration at 4000 vertices, 0.3 s a pair's scoring */
+    add_on(&s.c[0], "r", "register_random", 2.0, "", 0);
+    add_on(&s.c[0], "r", NULL, 0.01, "", 0);
+    add_on(&s.c[0], "r", "register_random", 4.0, "d/long", 4000);
+    add_on(&s.c[0], "r", NULL, 0.3, "d/long", 4000);
     tcb_cost_query q = {10, 2000, 100, 1};
     tcb_cost_estimate e = {.n_units = 1};
     snprintf(e.basis, sizeof e.basis, "random");
@@ -298,8 +300,7 @@ static void test_file_round_trip(void **state)
     add(&c, TCB_COST_SCORE_PAIR, "", "", 1, 0.0101);
     add_sized(&c, TCB_COST_UNIT, "nricp", "", "assign", 0, 1, 0.5);
     add_sized(&c, TCB_COST_SURFACE_FRAME, "atlasnet", "cpu", "", 100000, 2, 1.25);
-    add_sized(&c, TCB_COST_UNIT, "nricp", "", "register_random", 0, 1, 0.55);
-    on_sequence(&c, "ama/crane", 10002);
+    add_on(&c, "nricp", "register_random", 0.55, "ama/crane", 10002);
     char path[1024];
     snprintf(path, sizeof path, "%s/cal.json", dir);
     tcb_error err = {0};
