@@ -36,9 +36,10 @@ static int thread_list(const char *text, int *threads, int max, int *n)
     return 0;
 }
 
-/* The units of cfg's methods on each of its sequences (loaded as `run`
- * loads them), the budget shared between the sequences; a sequence of an
- * optional dataset that is absent is skipped, as a run skips it. */
+/* The units of cfg's methods and the scoring of a pair on each of its
+ * sequences (loaded as `run` loads them), the budget shared between the
+ * sequences; a sequence of an optional dataset that is absent is skipped,
+ * as a run skips it. */
 static int calibrate_on_config(const tcb_config *cfg, tcb_calibrate_opts *o, tcb_error *err)
 {
     const char **names = calloc((size_t)cfg->n_methods + 1, sizeof *names);
@@ -116,12 +117,13 @@ const cli_command cli_calibrate = {
         "step, then steps while its share of the budget lasts (at least one: the largest\n"
         "presets may overrun a small budget, which the last line says); a unit likewise.\n"
         "\n"
-        "With a CONFIG, only the units of its methods, measured on each of its sequences (the\n"
-        "budget shared between them) and written as costs of that sequence: the dry run prices\n"
-        "that sequence's units with them over the calibration sequence's, which it scales by\n"
-        "the vertex count only (a registration on a long, thin shape costs more per point: on\n"
-        "crane twice the calibration sequence's). Steps and evaluation pairs do not depend on\n"
-        "the sequence beyond its counts and are not measured again.\n"
+        "With a CONFIG, only the units of its methods and the scoring of a pair, measured on\n"
+        "each of its sequences (the budget shared between them) and written as costs of that\n"
+        "sequence: the dry run prices that sequence's cells with them over the calibration\n"
+        "sequence's, which it scales by the vertex count only (on crane a registration costs\n"
+        "twice the calibration sequence's per point, a pair's scoring 2.3 to 2.8 times its\n"
+        "scaled price). Training steps do not depend on the sequence beyond its counts and\n"
+        "are not measured again.\n"
         "\n"
         "The dry run reads, first match wins: <run dir>/calibration.json (a calibration made\n"
         "on the nodes that run it: --out RUN_DIR/calibration.json in a job there), the user's\n"

@@ -13,7 +13,7 @@
  * part lasts, at least one. A measurement whose warm-ups and single runs
  * exceed its share overruns the budget, which the closing line says.
  *
- * On a config's sequence (o->methods set) only the units of the config's
+ * On a config's sequence (on_config: o->methods set) only the units of the config's
  * methods and the harness's scoring of a pair are measured, on that
  * sequence: what they cost depends on the shape as much as on the counts
  * the calibration sequence's costs are scaled by (docs/cluster.md); a
@@ -77,13 +77,16 @@ static int plan_method(const tcb_calibrate_opts *o, const tcb_method_ops *ops, m
     return found;
 }
 
+/* A calibration of a config's sequence (`tcbench calibrate CONFIG`). */
+static int on_config(const tcb_calibrate_opts *o) { return o->methods != NULL; }
+
 /* Whether ops is measured: it has costs to measure (on a config's
  * sequence: units, and it is one of the config's methods), and --only
  * names it or nothing. */
 static int measured(const tcb_calibrate_opts *o, const tcb_method_ops *ops)
 {
     if (o->method && strcmp(o->method, ops->name)) return 0;
-    if (!o->methods) return has_steps(ops) || n_units(ops);
+    if (!on_config(o)) return has_steps(ops) || n_units(ops);
     int listed = o->n_methods == 0;
     for (int k = 0; k < o->n_methods && !listed; k++) listed = !strcmp(o->methods[k], ops->name);
     return listed && n_units(ops);
@@ -100,7 +103,7 @@ static int plan(const tcb_calibrate_opts *o, measurement *m, int *n, tcb_error *
         methods++;
         presets += plan_method(o, ops, m, &counted);
     }
-    if (o->methods && !methods && o->method)
+    if (on_config(o) && !methods && o->method)
         return tcb_fail(err, TCB_ERR_INPUT, "calibrate: --only %s: not a method of the config with units to measure "
                         "on its sequences", o->method);
     if (o->method && !methods)
@@ -184,7 +187,7 @@ static int measure_unit(const session *s, const measurement *m, void *self, int 
     tcb_cost_entry *e = !rc && !(rc = add(s->cal, TCB_COST_UNIT, m, t.step_s, t.steps, err))
                             ? &s->cal->entries[s->cal->n - 1] : NULL;
     if (e) snprintf(e->unit, sizeof e->unit, "%s", m->ops->units[k]);
-    if (e && s->o->sequence) {
+    if (e && on_config(s->o)) {
         snprintf(e->sequence, sizeof e->sequence, "%s", s->o->sequence_name);
         e->vertices = s->seq->n_verts;
     }
@@ -200,7 +203,7 @@ static int measure(const session *s, const measurement *m, int t_index, double s
     void *self;
     int rc = m->ops->create(params, &self, err);
     if (rc) return rc;
-    int units = n_units(m->ops), steps = has_steps(m->ops) && !s->o->sequence;
+    int units = n_units(m->ops), steps = has_steps(m->ops) && !on_config(s->o);
     int surface = steps && surface_measured(s, m);
     double part = 0.8 * share / (steps + surface + units);
     if (steps) rc = measure_steps(s, m, self, t_index, part, err);
@@ -251,13 +254,13 @@ static int measure_all(const session *s, const measurement *m, int n, tcb_error 
             return rc;
         }
     }
-    int rc = s->o->sequence ? measure_scoring(s, err) : TCB_OK;
+    int rc = on_config(s->o) ? measure_scoring(s, err) : TCB_OK;
     if (rc) return rc;
     for (int t = 0; t < s->o->n_threads; t++) {
         tcb_cost_entry e = {.kind = TCB_COST_SCORE_PAIR, .threads = s->o->threads[t], .samples = s->score_n[t]};
         e.seconds = s->score_n[t] ? s->score_s[t] / s->score_n[t] : 0;
-        if (s->o->sequence) snprintf(e.sequence, sizeof e.sequence, "%s", s->o->sequence_name);
-        e.vertices = s->o->sequence ? s->seq->n_verts : 0;
+        if (on_config(s->o)) snprintf(e.sequence, sizeof e.sequence, "%s", s->o->sequence_name);
+        e.vertices = on_config(s->o) ? s->seq->n_verts : 0;
         rc = s->score_n[t] ? tcb_calibration_add(s->cal, &e, err) : TCB_OK;
         if (rc) return rc;
         if (s->score_n[t])
@@ -325,8 +328,22 @@ int tcb_calibrate_check(const tcb_calibrate_opts *o, tcb_error *err)
     return plan(o, NULL, &n, err);
 }
 
+/* The first line: what is measured, where, in what budget. */
+static void announce(const tcb_calibrate_opts *o, const char *machine, int n, FILE *out)
+{
+    if (on_config(o))
+        fprintf(out, "calibrating on %s: %d measurements of units, and the scoring of pairs, on %s (%d frames, %d "
+                "vertices) in a budget of %.0f s\n", machine, n, o->sequence_name, o->sequence->n_frames,
+                o->sequence->n_verts, o->budget_s);
+    else
+        fprintf(out, "calibrating on %s: %d measurements in a budget of %.0f s (%s)\n", machine, n, o->budget_s,
+                o->quick ? "quick: coarse" : "a warm-up step, then steps while the budget lasts");
+}
+
 int tcb_calibrate(const tcb_calibrate_opts *o, FILE *out, tcb_error *err)
 {
+    if (on_config(o) && !o->sequence)
+        return tcb_fail(err, TCB_ERR_INTERNAL, "calibrate: a config's methods without its sequence");
     int n = 0;
     int rc = plan(o, NULL, &n, err);
     measurement *m = rc ? NULL : calloc(n ? (size_t)n : 1, sizeof *m);
@@ -343,17 +360,11 @@ int tcb_calibrate(const tcb_calibrate_opts *o, FILE *out, tcb_error *err)
         rc = tcb_fail(err, TCB_ERR_NOMEM, "out of memory");
     if (!rc) {
         cal.n_verts = seq.n_verts, cal.n_frames = seq.n_frames;
-        if (o->sequence)
-            fprintf(out, "calibrating on %s: %d measurements of units, and the scoring of pairs, on %s (%d frames, "
-                    "%d vertices) in a budget of %.0f s\n", cal.machine, n, o->sequence_name, o->sequence->n_frames, o->sequence->n_verts,
-                    o->budget_s);
-        else
-            fprintf(out, "calibrating on %s: %d measurements in a budget of %.0f s (%s)\n", cal.machine, n,
-                    o->budget_s, o->quick ? "quick: coarse" : "a warm-up step, then steps while the budget lasts");
+        announce(o, cal.machine, n, out);
     }
     int prev = omp_get_max_threads();
     double t0 = tcb_now_seconds();
-    session s = {o, o->sequence ? o->sequence : &seq, &cal, score_s, score_n, out};
+    session s = {o, on_config(o) ? o->sequence : &seq, &cal, score_s, score_n, out};
     if (!rc) rc = measure_all(&s, m, n, err);
     omp_set_num_threads(prev);
     double took = tcb_now_seconds() - t0;
