@@ -94,22 +94,25 @@ typedef struct tcb_calibration_set {
 int tcb_calibration_set_load(const char *run_dir, tcb_calibration_set *s, tcb_error *err);
 void tcb_calibration_set_free(tcb_calibration_set *s);
 
-/* The cost at `threads` from the first calibration that measured key (a
- * surface frame's per sample of a mesh): the measured value, else interpolated log-linearly in
- * the thread count between the nearest measured counts, else extrapolated
+/* The cost at `threads` from the first calibration that measured key on
+ * key->sequence, else from the first that measured it on the calibration
+ * sequence (a surface frame's per sample of a mesh): the measured value,
+ * else interpolated log-linearly in the thread count between the nearest measured counts, else extrapolated
  * with the scaling of the last two (at best linear, never slower with more
  * threads; constant from a single count). */
 typedef struct tcb_cost_price {
     double seconds;
     const tcb_calibration *from;
     int vertices;       /* of the sequence it was measured on */
+    int on_sequence;    /* the key's sequence's own cost (else the calibration sequence's) */
     int lo, hi;         /* the measured thread counts it derives from */
     int extrapolated;   /* threads outside [lo, hi] */
 } tcb_cost_price;
 typedef struct tcb_cost_key {
     tcb_cost_kind kind;
     const char *method, *preset, *unit; /* "" where the kind has none */
-    const char *sequence;               /* a unit's measured on this sequence; NULL or "": the calibration sequence's */
+    const char *sequence;               /* a unit's or the scoring's on this sequence first; NULL or "": only
+                                         * the calibration sequence's */
 } tcb_cost_key;
 int tcb_cost_lookup(const tcb_calibration_set *s, const tcb_cost_key *key, int threads, tcb_cost_price *out);
 

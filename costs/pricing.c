@@ -67,9 +67,9 @@ static void price_curve(const cost_curve *c, int threads, tcb_cost_price *out)
     out->seconds = c->seconds[from] * pow((double)threads / c->threads[from], exponent(c, a, out->extrapolated));
 }
 
-int tcb_cost_lookup(const tcb_calibration_set *s, const tcb_cost_key *key, int threads, tcb_cost_price *out)
+/* key's cost on exactly key->sequence ("" the calibration sequence's). */
+static int lookup_exact(const tcb_calibration_set *s, const tcb_cost_key *key, int threads, tcb_cost_price *out)
 {
-    memset(out, 0, sizeof *out);
     for (int k = 0; k < s->n; k++) {
         cost_curve c;
         curve_of(&s->c[k], key, &c);
@@ -80,6 +80,15 @@ int tcb_cost_lookup(const tcb_calibration_set *s, const tcb_cost_key *key, int t
         return 0;
     }
     return -1;
+}
+
+int tcb_cost_lookup(const tcb_calibration_set *s, const tcb_cost_key *key, int threads, tcb_cost_price *out)
+{
+    memset(out, 0, sizeof *out);
+    tcb_cost_key general = *key;
+    general.sequence = NULL;
+    out->on_sequence = key->sequence && key->sequence[0] && !lookup_exact(s, key, threads, out);
+    return out->on_sequence ? 0 : lookup_exact(s, &general, threads, out);
 }
 
 /* "2 threads" / "3 threads interpolated from 2-4" / "16 threads extrapolated from 1-2". */
@@ -110,11 +119,9 @@ static void data_absent(tcb_cost_estimate *e, const char *grows)
 static double score_seconds(const tcb_calibration_set *s, const char *sequence, const tcb_cost_query *q, int *own)
 {
     tcb_cost_price p;
-    const tcb_cost_key own_key = {TCB_COST_SCORE_PAIR, "", "", "", sequence};
-    const tcb_cost_key key = {TCB_COST_SCORE_PAIR, "", "", "", NULL};
-    if (q->n_verts < 1) return -1;
-    *own = sequence && sequence[0] && !tcb_cost_lookup(s, &own_key, q->n_threads, &p);
-    if (!*own && tcb_cost_lookup(s, &key, q->n_threads, &p)) return -1;
+    const tcb_cost_key key = {TCB_COST_SCORE_PAIR, "", "", "", sequence};
+    if (q->n_verts < 1 || tcb_cost_lookup(s, &key, q->n_threads, &p)) return -1;
+    *own = p.on_sequence;
     double r = (double)q->n_verts / p.vertices;
     return q->n_pairs * p.seconds * r * r;
 }
@@ -152,17 +159,14 @@ static int price_preset(const tcb_calibration_set *s, const char *method, const 
 }
 
 /* One unit use's seconds into *fit, *eval, from its cost measured on the
- * cell's sequence where there is one (returns 2), else on the calibration
- * sequence (1); 0 when unknown (e says why). */
+ * cell's sequence where there is one (p->on_sequence), else on the
+ * calibration sequence; 0 when unknown (e says why). */
 static int price_unit(const tcb_calibration_set *s, const char *method, const char *sequence,
                       const tcb_cost_query *q, const tcb_unit_use *u, tcb_cost_estimate *e, double *fit, double *eval,
                       tcb_cost_price *p)
 {
-    const tcb_cost_key own = {TCB_COST_UNIT, method, e->preset, u->unit, sequence};
-    const tcb_cost_key key = {TCB_COST_UNIT, method, e->preset, u->unit, NULL};
-    int threads = u->threads > 0 ? u->threads : q->n_threads;
-    int measured_on_it = sequence && sequence[0] && !tcb_cost_lookup(s, &own, threads, p);
-    if (!measured_on_it && tcb_cost_lookup(s, &key, threads, p)) {
+    const tcb_cost_key key = {TCB_COST_UNIT, method, e->preset, u->unit, sequence};
+    if (tcb_cost_lookup(s, &key, u->threads > 0 ? u->threads : q->n_threads, p)) {
         char what[64];
         snprintf(what, sizeof what, "unit %.31s", u->unit);
         unknown(e, what, method, e->preset);
@@ -174,7 +178,7 @@ static int price_unit(const tcb_calibration_set *s, const char *method, const ch
     }
     double each = p->seconds * (u->exponent != 0 ? pow((double)q->n_verts / p->vertices, u->exponent) : 1);
     *fit = u->fit * each, *eval = u->eval * each;
-    return measured_on_it ? 2 : 1;
+    return 1;
 }
 
 /* The units' seconds added to fit_s and eval_s; the basis names the
@@ -192,8 +196,7 @@ static int price_units(const tcb_calibration_set *s, const char *method, const c
         const tcb_unit_use *u = &e->units[k];
         double fit, eval;
         tcb_cost_price p;
-        int from = price_unit(s, method, sequence, q, u, e, &fit, &eval, &p);
-        if (!from) return 0;
+        if (!price_unit(s, method, sequence, q, u, e, &fit, &eval, &p)) return 0;
         e->fit_s += fit, e->eval_s += eval;
         if (fit + eval <= most) continue;
         char threads[64];
@@ -204,7 +207,7 @@ static int price_units(const tcb_calibration_set *s, const char *method, const c
         int len = snprintf(costliest, sizeof costliest, count == floor(count) && count < 1e15 ? "%.0f %.31s x %.3g s"
                                                                                               : "%.4g %.31s x %.3g s",
                            count, u->unit, fit + eval > 0 ? (fit + eval) / count : 0.0);
-        if (from == 2 && len > 0 && (size_t)len < sizeof costliest)
+        if (p.on_sequence && len > 0 && (size_t)len < sizeof costliest)
             len += snprintf(costliest + len, sizeof costliest - (size_t)len, " measured on %.60s", sequence);
         if (!after_steps && len > 0 && (size_t)len < sizeof costliest)
             snprintf(costliest + len, sizeof costliest - (size_t)len, " (%.40s, %.50s)", threads, p.from->machine);

@@ -11,6 +11,7 @@
 #include "scoring/scoring.h"
 #include "tcb/metrics.h"
 #include "tcb/rng.h"
+#include "tcb/split.h"
 #include "tcb/synth.h"
 
 int tcb_calibration_sequence(tcb_sequence *s, tcb_error *err)
@@ -186,8 +187,8 @@ int tcb_time_eval_pairs(const tcb_method_ops *ops, void *self, const tcb_sequenc
     tcb_rng_seed_stream(&pairs, 0, "calibrate/pairs");
     /* pair -1, untimed, sets up what a cell's evaluation sets up once */
     for (int k = -1; !rc && k < n; k++) {
-        uint32_t f = (uint32_t)seq->n_frames, a = tcb_rng_below(&pairs, f);
-        int i = (int)a, j = (int)((a + 1 + tcb_rng_below(&pairs, f - 1)) % f);
+        int i = (int)tcb_rng_below(&pairs, (uint32_t)seq->n_frames);
+        int j = tcb_pair_sample(TCB_PAIRS_RANDOM, 0, seq->n_frames, 0, seq->n_frames, i, &pairs);
         double before = *method_s;
         rc = method_pair(ops, self, seq, i, j, moved, method_s, err);
         tcb_pair_prediction p = {i, j, moved, pred, NAN, NULL};

@@ -22,6 +22,7 @@
 #include "methods/params.h"
 #include "tcb/json.h"
 #include "tcb/rng.h"
+#include "tcb/split.h"
 
 #define WHERE "nricp.params"
 
@@ -160,9 +161,9 @@ static int nricp_run_unit(void *self, const tcb_sequence *seq, const tcb_fit_ctx
     nricp_method *m = self;
     int rc = m->normals && m->n_frames == seq->n_frames && m->n_verts == seq->n_verts ? TCB_OK
                                                                                       : nricp_prepare(m, seq, err);
-    /* random: an ordered pair of distinct frames, uniform; else a frame and the next */
-    uint32_t f = (uint32_t)seq->n_frames, a = tcb_rng_below(&m->unit_pairs, unit == UNIT_RANDOM ? f : f - 1);
-    uint32_t b = unit == UNIT_RANDOM ? (a + 1 + tcb_rng_below(&m->unit_pairs, f - 1)) % f : a + 1;
+    /* random: an ordered pair of distinct frames, as a split draws it; else a frame and the next */
+    int f = seq->n_frames, a = (int)tcb_rng_below(&m->unit_pairs, (uint32_t)(unit == UNIT_RANDOM ? f : f - 1));
+    int b = unit == UNIT_RANDOM ? tcb_pair_sample(TCB_PAIRS_RANDOM, 0, f, 0, f, a, &m->unit_pairs) : a + 1;
     int nv = seq->n_verts;
     float *out = rc ? NULL : malloc((size_t)nv * 3 * sizeof *out);
     int32_t *map = rc ? NULL : malloc((size_t)nv * sizeof *map);
