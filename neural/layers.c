@@ -2,6 +2,7 @@
 
 #include <cblas.h>
 #include <math.h>
+#include <omp.h>
 #include <stddef.h>
 #include <string.h>
 
@@ -18,7 +19,37 @@
 /* Below this many multiply-adds a thread team costs more than it saves. */
 #define PAR_MIN 32768.0
 
+/* Below this many multiply-adds a product runs as one OpenBLAS call. */
+#define SPLIT_MIN 1048576.0
+
 static int imin(int a, int b) { return a < b ? a : b; }
+
+/* C [rows][n] = A [rows][k] · op(B) + beta·C, row-major (op(B) = Bᵀ with B
+ * [n][k] when b_trans, else B [k][n]), the rows cut into one even block per
+ * OpenMP thread, each block a single-threaded OpenBLAS call (the OpenMP
+ * build runs a call made inside a parallel region on its caller's thread).
+ * Why not OpenBLAS's own threads: on the layers' tall narrow products
+ * (rows ≫ n, k ≤ 128) they wait on one another's packed panels; at two
+ * threads this split ran cc's and dynosurf's layers 1.05–1.8× faster
+ * forward and 1.0–1.2× backward, neupig's 512-wide one as fast
+ * (bench/linear.c; docs/protocol.md, "Row-split products").
+ * The blocks depend on the thread count only, so a given count gives the
+ * same bits every run; one thread is the one call as before. (OpenBLAS's
+ * edge tiles round otherwise than its full ones, so the bits of a row
+ * depend on where its block starts: no split is the same at every count.) */
+static void sgemm_rows(int b_trans, int rows, int n, int k, const float *A, const float *B, float beta,
+                       float *C)
+{
+    int ldb = b_trans ? k : n;
+#pragma omp parallel if ((double)rows * n * k > SPLIT_MIN)
+    {
+        int t = omp_get_thread_num(), T = omp_get_num_threads();
+        int r0 = (int)((long long)rows * t / T), r1 = (int)((long long)rows * (t + 1) / T);
+        if (r1 > r0)
+            cblas_sgemm(CblasRowMajor, CblasNoTrans, b_trans ? CblasTrans : CblasNoTrans, r1 - r0, n, k, 1.0f,
+                        A + (size_t)r0 * k, k, B, ldb, beta, C + (size_t)r0 * n, n);
+    }
+}
 
 void tcb_linear_bind(tcb_linear *l, float *base, size_t *offset, int in, int out)
 {
@@ -156,8 +187,7 @@ void tcb_linear_forward(float *y, const float *x, const float *W, const float *b
     else if (out <= TINY)
         tiny_out_forward(y, x, W, rows, in, out);
     else
-        cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, rows, out, in, 1.0f, x, in, W, in,
-                    1.0f, y, out);
+        sgemm_rows(1, rows, out, in, x, W, 1.0f, y);
 }
 
 void tcb_linear_backward(float *dx, float *dW, float *db, const float *dy, const float *x,
@@ -172,9 +202,7 @@ void tcb_linear_backward(float *dx, float *dW, float *db, const float *dy, const
     }
     cblas_sgemm(CblasRowMajor, CblasTrans, CblasNoTrans, out, in, rows, 1.0f, dy, out, x, in,
                 1.0f, dW, in);
-    if (dx)
-        cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, rows, in, out, 1.0f, dy, out, W,
-                    in, 0.0f, dx, in);
+    if (dx) sgemm_rows(0, rows, in, out, dy, W, 0.0f, dx);
 }
 
 void tcb_relu_forward(float *y, const float *x, int64_t n)

@@ -21,6 +21,7 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -222,6 +223,51 @@ static void test_linear(void **state)
     check_linear(5, 3, 70, &rng); /* fused, several column chunks */
     check_linear(5, 6, 3, &rng);  /* fused: the xyz output */
     check_linear(40, 70, 3, &rng); /* fused, several column chunks */
+}
+
+/* A product large enough to be cut into row blocks, one per thread
+ * (neural/layers.c, sgemm_rows), with an odd row count so the blocks differ
+ * in size: y and dx at one thread and at two against the double reference
+ * (a block's rows or its offsets wrong show there). */
+static void test_linear_threads(void **state)
+{
+    (void)state;
+    enum { rows = 1001, in = 100, out = 70 };
+    tcb_rng rng;
+    tcb_rng_seed_stream(&rng, 1, "test/atlas/linear_threads");
+    float *x = tu_falloc((size_t)rows * in), *W = tu_falloc((size_t)out * in), *b = tu_falloc(out);
+    float *dy = tu_falloc((size_t)rows * out), *dW = tu_falloc((size_t)out * in);
+    float *y[2] = {tu_falloc((size_t)rows * out), tu_falloc((size_t)rows * out)};
+    float *dx[2] = {tu_falloc((size_t)rows * in), tu_falloc((size_t)rows * in)};
+    tu_fill_uniform(&rng, x, (size_t)rows * in, -1, 1);
+    tu_fill_uniform(&rng, W, (size_t)out * in, -1, 1);
+    tu_fill_uniform(&rng, b, out, -1, 1);
+    tu_fill_uniform(&rng, dy, (size_t)rows * out, -1, 1);
+    int prev = omp_get_max_threads();
+    for (int t = 0; t < 2; t++) {
+        omp_set_num_threads(t + 1);
+        tcb_linear_forward(y[t], x, W, b, rows, 0, in, out);
+        tcb_linear_backward(dx[t], dW, NULL, dy, x, W, rows, 0, in, out);
+    }
+    omp_set_num_threads(prev);
+
+    double *xd = tu_to_double(x, (size_t)rows * in), *Wd = tu_to_double(W, (size_t)out * in);
+    double *bd = tu_to_double(b, out), *ref = malloc((size_t)rows * (out > in ? out : in) * sizeof(double));
+    ref_layer L = {Wd, bd, in, out};
+    for (int r = 0; r < rows; r++) ref_affine(ref + (size_t)r * out, L, xd + (size_t)r * in, 1);
+    check_forward("linear y, 1 thread", y[0], ref, (size_t)rows * out);
+    check_forward("split linear y", y[1], ref, (size_t)rows * out);
+    for (int r = 0; r < rows; r++)
+        for (int i = 0; i < in; i++) {
+            double s = 0;
+            for (int o = 0; o < out; o++) s += (double)dy[(size_t)r * out + o] * Wd[(size_t)o * in + i];
+            ref[(size_t)r * in + i] = s;
+        }
+    check_forward("linear dx, 1 thread", dx[0], ref, (size_t)rows * in);
+    check_forward("split linear dx", dx[1], ref, (size_t)rows * in);
+
+    free(x), free(W), free(b), free(dy), free(dW), free(y[0]), free(y[1]), free(dx[0]), free(dx[1]);
+    free(xd), free(Wd), free(bd), free(ref);
 }
 
 typedef struct {
@@ -655,7 +701,7 @@ static void test_model_grad(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_linear),          cmocka_unit_test(test_relu), cmocka_unit_test(test_leaky_relu),
+        cmocka_unit_test(test_linear),          cmocka_unit_test(test_linear_threads), cmocka_unit_test(test_relu), cmocka_unit_test(test_leaky_relu),
         cmocka_unit_test(test_softplus),        cmocka_unit_test(test_maxpool),
         cmocka_unit_test(test_decoder_tangents), cmocka_unit_test(test_decoder_grad),
         cmocka_unit_test(test_encoder_grad),    cmocka_unit_test(test_model_grad),
