@@ -5,6 +5,7 @@
 #include <math.h>
 
 #include "neural/layers.h"
+#include "neural/parallel.h"
 
 /* Row blocks of a reduction: a fixed partition, summed each in order and
  * then added in block order, so results do not depend on the thread count
@@ -12,9 +13,6 @@
  * columns stride across rows and miss the caches and the TLB (16-column
  * tasks over 256 columns: 8× slower, measured). */
 #define NB 4
-
-/* Below this many elements a thread team costs more than it saves. */
-#define PAR_MIN 32768.0
 
 /* s1 = Σ_r u and s2 = Σ_r u·v per column over the n rows, with u = a − sa
  * and v = b − sb (sa, sb [C]), summed in double. One pass serves both the
@@ -24,7 +22,7 @@ static void moments(const float *a, const float *b, const float *sa, const float
                     double *s2)
 {
     double part[NB][2][TCB_BN_MAX_C];
-#pragma omp parallel for schedule(static) if ((double)n * C > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)n * C > TCB_PAR_MIN)
     for (int k = 0; k < NB; k++) {
         int r0 = (int)((long long)n * k / NB), r1 = (int)((long long)n * (k + 1) / NB);
         double *p1 = part[k][0], *p2 = part[k][1];
@@ -95,7 +93,7 @@ void tcb_batchnorm_forward_train(const tcb_batchnorm *bn, float *y, float *xhat,
     float mlo[TCB_BN_MAX_C];
     batch_stats(x, n, C, rstd, mu, mlo, var2);
     const float *g = bn->gamma, *b = bn->beta;
-#pragma omp parallel for schedule(static) if ((double)n * C > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)n * C > TCB_PAR_MIN)
     for (int r = 0; r < n; r++) {
         size_t at = (size_t)r * C;
 #pragma omp simd
@@ -116,7 +114,7 @@ void tcb_batchnorm_maxpool_forward_train(const tcb_batchnorm *bn, float *g, int3
     /* each set's rows through BN one at a time into a row buffer, and the
      * max taken as tcb_maxpool_forward takes it (the first row of the
      * largest value) */
-#pragma omp parallel for schedule(static) if ((double)nb * n * C > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)nb * n * C > TCB_PAR_MIN)
     for (int b = 0; b < nb; b++) {
         float y[TCB_BN_MAX_C];
         float *gb = g + (size_t)b * C;
@@ -149,7 +147,7 @@ void tcb_batchnorm_forward_eval(const tcb_batchnorm *bn, float *y, const float *
     float sc[TCB_BN_MAX_C];
     for (int j = 0; j < C; j++) sc[j] = (float)(bn->gamma[j] / sqrt((double)bn->var[j] + TCB_BN_EPS));
     const float *m = bn->mean, *b = bn->beta;
-#pragma omp parallel for schedule(static) if ((double)n * C > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)n * C > TCB_PAR_MIN)
     for (int r = 0; r < n; r++) {
         size_t at = (size_t)r * C;
 #pragma omp simd
@@ -186,7 +184,7 @@ void tcb_batchnorm_backward(const tcb_batchnorm *bn, const tcb_batchnorm *grad, 
     moments(dy, xhat, zero, zero, n, C, sd, sdx);
     float a[TCB_BN_MAX_C], mb[TCB_BN_MAX_C], mg[TCB_BN_MAX_C];
     backward_coefficients(bn, grad, rstd, sd, sdx, n, a, mb, mg);
-#pragma omp parallel for schedule(static) if ((double)n * C > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)n * C > TCB_PAR_MIN)
     for (int r = 0; r < n; r++) {
         size_t at = (size_t)r * C;
 #pragma omp simd
@@ -230,7 +228,7 @@ void tcb_batchnorm_maxpool_backward(const tcb_batchnorm *bn, const tcb_batchnorm
     backward_coefficients(bn, grad, rstd, sd, sdx, R, a, mb, mg);
     /* tcb_batchnorm_backward's dx with dy = 0 everywhere, then the max rows
      * with their dy */
-#pragma omp parallel for schedule(static) if ((double)R * C > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)R * C > TCB_PAR_MIN)
     for (int r = 0; r < R; r++) {
         size_t at = (size_t)r * C;
 #pragma omp simd

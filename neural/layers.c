@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "neural/parallel.h"
 #include "tcb/rng.h"
 
 /* Dimensions up to this are "tiny": a GEMM with a 3-wide side spends its
@@ -15,9 +16,6 @@
 /* Column chunk of the reductions over rows: one thread owns a chunk, so each
  * sum runs over the rows in order whatever the thread count. */
 #define CHUNK 64
-
-/* Below this many multiply-adds a thread team costs more than it saves. */
-#define PAR_MIN 32768.0
 
 /* Below this many multiply-adds a product runs as one OpenBLAS call. */
 #define SPLIT_MIN 1048576.0
@@ -70,7 +68,7 @@ void tcb_linear_bind_nobias(tcb_linear *l, float *base, size_t *offset, int in, 
 void tcb_colsum_acc(float *db, const float *dy, int n, int d)
 {
     int nchunks = (d + CHUNK - 1) / CHUNK;
-#pragma omp parallel for schedule(static) if ((double)n * d > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)n * d > TCB_PAR_MIN)
     for (int c = 0; c < nchunks; c++) {
         int lo = c * CHUNK, w = imin(d, lo + CHUNK) - lo;
         double acc[CHUNK] = {0};
@@ -85,7 +83,7 @@ void tcb_colsum_acc(float *db, const float *dy, int n, int d)
 /* y[rows][d] = b on the first n rows, 0 on the rest (b NULL: 0 everywhere). */
 static void fill_bias(float *y, const float *b, int n, int rows, int d)
 {
-#pragma omp parallel for schedule(static) if ((double)rows * d > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)rows * d > TCB_PAR_MIN)
     for (int r = 0; r < rows; r++) {
         float *yr = y + (size_t)r * d;
         if (b && r < n) memcpy(yr, b, (size_t)d * sizeof(float));
@@ -102,7 +100,7 @@ static void tiny_in_forward(float *y, const float *x, const float *W, int rows, 
         float wt[TINY][CHUNK];
         for (int k = 0; k < in; k++)
             for (int j = 0; j < w; j++) wt[k][j] = W[(size_t)(lo + j) * in + k];
-#pragma omp parallel for schedule(static) if ((double)rows * in * w > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)rows * in * w > TCB_PAR_MIN)
         for (int r = 0; r < rows; r++) {
             float *yr = y + (size_t)r * out + lo;
             for (int k = 0; k < in; k++) {
@@ -117,7 +115,7 @@ static void tiny_in_forward(float *y, const float *x, const float *W, int rows, 
 /* y[rows][out] += x[rows][in]·Wᵀ for a tiny out: a dot product per output. */
 static void tiny_out_forward(float *y, const float *x, const float *W, int rows, int in, int out)
 {
-#pragma omp parallel for schedule(static) if ((double)rows * in * out > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)rows * in * out > TCB_PAR_MIN)
     for (int r = 0; r < rows; r++) {
         const float *xr = x + (size_t)r * in;
         float *yr = y + (size_t)r * out;
@@ -135,7 +133,7 @@ static void tiny_out_forward(float *y, const float *x, const float *W, int rows,
 static void tiny_backward_input(float *dx, const float *dy, const float *W, int rows, int in,
                                 int out)
 {
-#pragma omp parallel for schedule(static) if ((double)rows * in * out > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)rows * in * out > TCB_PAR_MIN)
     for (int r = 0; r < rows; r++) {
         const float *g = dy + (size_t)r * out;
         float *dxr = dx + (size_t)r * in;
@@ -154,7 +152,7 @@ static void tiny_backward_weight(float *dW, const float *dy, const float *x, int
 {
     int in_big = in >= out, big = in_big ? in : out, small = in_big ? out : in;
     int nchunks = (big + CHUNK - 1) / CHUNK;
-#pragma omp parallel for schedule(static) if ((double)rows * in * out > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)rows * in * out > TCB_PAR_MIN)
     for (int c = 0; c < nchunks; c++) {
         int lo = c * CHUNK, w = imin(big, lo + CHUNK) - lo;
         double acc[TINY][CHUNK] = {{0}};
@@ -207,13 +205,13 @@ void tcb_linear_backward(float *dx, float *dW, float *db, const float *dy, const
 
 void tcb_relu_forward(float *y, const float *x, int64_t n)
 {
-#pragma omp parallel for schedule(static) if ((double)n > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)n > TCB_PAR_MIN)
     for (int64_t i = 0; i < n; i++) y[i] = x[i] > 0.0f ? x[i] : 0.0f;
 }
 
 void tcb_relu_backward(float *dx, const float *dy, const float *y, int64_t n)
 {
-#pragma omp parallel for schedule(static) if ((double)n > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)n > TCB_PAR_MIN)
     for (int64_t i = 0; i < n; i++) dx[i] = y[i] > 0.0f ? dy[i] : 0.0f;
 }
 
@@ -227,13 +225,13 @@ void tcb_linear_init_uniform(const tcb_linear *l, tcb_rng *rng)
 
 void tcb_leaky_relu_forward(float *y, const float *x, int64_t n, float slope)
 {
-#pragma omp parallel for schedule(static) if ((double)n > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)n > TCB_PAR_MIN)
     for (int64_t i = 0; i < n; i++) y[i] = x[i] > 0.0f ? x[i] : slope * x[i];
 }
 
 void tcb_leaky_relu_backward(float *dx, const float *dy, const float *y, int64_t n, float slope)
 {
-#pragma omp parallel for schedule(static) if ((double)n > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)n > TCB_PAR_MIN)
     for (int64_t i = 0; i < n; i++) dx[i] = y[i] > 0.0f ? dy[i] : slope * dy[i];
 }
 
@@ -242,7 +240,7 @@ void tcb_leaky_relu_backward(float *dx, const float *dy, const float *y, int64_t
 void tcb_softplus_forward(float *y, const float *x, int n, int nt, int d)
 {
     size_t blk = (size_t)n * d;
-#pragma omp parallel for schedule(static) if ((double)n * d > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)n * d > TCB_PAR_MIN)
     for (int r = 0; r < n; r++) {
         for (int lo = 0; lo < d; lo += CHUNK) {
             size_t at = (size_t)r * d + lo;
@@ -266,7 +264,7 @@ void tcb_softplus_backward(float *dx, const float *dy, const float *x, int n, in
                                  int d)
 {
     size_t blk = (size_t)n * d;
-#pragma omp parallel for schedule(static) if ((double)n * d > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)n * d > TCB_PAR_MIN)
     for (int r = 0; r < n; r++) {
         for (int lo = 0; lo < d; lo += CHUNK) {
             size_t at = (size_t)r * d + lo;
@@ -295,7 +293,7 @@ void tcb_softplus_backward(float *dx, const float *dy, const float *x, int n, in
 
 void tcb_maxpool_forward(float *y, int32_t *arg, const float *x, int nb, int n, int d)
 {
-#pragma omp parallel for schedule(static) if ((double)nb * n * d > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)nb * n * d > TCB_PAR_MIN)
     for (int b = 0; b < nb; b++) {
         const float *xb = x + (size_t)b * n * d;
         float *yb = y + (size_t)b * d;
@@ -315,7 +313,7 @@ void tcb_maxpool_linear_backward(float *dx, float *dW, float *db, const float *d
 {
     tcb_colsum_acc(db, dy, nb, out);
     /* dW: each channel's row owned by one thread, the sets summed in order */
-#pragma omp parallel for schedule(static) if ((double)nb * in * out > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)nb * in * out > TCB_PAR_MIN)
     for (int o = 0; o < out; o++) {
         float *dw = dW + (size_t)o * in;
         for (int b = 0; b < nb; b++) {
@@ -326,7 +324,7 @@ void tcb_maxpool_linear_backward(float *dx, float *dW, float *db, const float *d
     }
     /* dx: each set owned by one thread, the channels added in order */
     memset(dx, 0, (size_t)nb * n * in * sizeof(float));
-#pragma omp parallel for schedule(static) if ((double)nb * in * out > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)nb * in * out > TCB_PAR_MIN)
     for (int b = 0; b < nb; b++)
         for (int o = 0; o < out; o++) {
             float g = dy[(size_t)b * out + o];

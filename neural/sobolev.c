@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "neural/parallel.h"
+
 const char *const tcb_sobolev_laplacian_names[] = {"pcgrid", "graph", NULL};
 
 /* LAPACK's eigensolver of a symmetric tridiagonal matrix (OpenBLAS carries
@@ -72,10 +74,6 @@ void tcb_sobolev_free(tcb_sobolev *s)
     memset(s, 0, sizeof *s);
 }
 
-/* Below this many multiply-adds a transform runs on one thread: a team
- * costs more than the work (batchnorm.c's threshold). */
-#define PAR_MIN 32768.0
-
 /* In place along one axis of a [r][r][r][F] array (element stride `step`
  * along the axis): a ← Qᵀ a (to the eigenbasis) or a ← Q a (back). The
  * r² lines along the axis are independent: side by side on the threads,
@@ -84,7 +82,7 @@ void tcb_sobolev_free(tcb_sobolev *s)
 static void transform_axis(const double *Q, int r, int F, size_t step, int to_basis, double *a)
 {
     size_t s = step / (size_t)F, lines = (size_t)r * r;
-#pragma omp parallel for schedule(static) if ((double)lines * F * r * r > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)lines * F * r * r > TCB_PAR_MIN)
     for (size_t L = 0; L < lines; L++) {
         double line[1024];
         size_t base = L / s * s * (size_t)r + L % s;

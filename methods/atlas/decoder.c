@@ -4,8 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Below this many multiply-adds a thread team costs more than it saves. */
-#define PAR_MIN 32768.0
+#include "neural/parallel.h"
 
 void tcb_atlas_decoder_dims(int C, int k, int *in, int *out)
 {
@@ -73,7 +72,7 @@ static void layer1_forward(const tcb_atlas_decoder_cache *c, const float *uv, in
     int m = c->m, R = c->nz * m;
     size_t blk = (size_t)R * h1;
     const float *wu = c->wuv, *wv = c->wuv + h1;
-#pragma omp parallel for schedule(static) if ((double)R * h1 > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)R * h1 > TCB_PAR_MIN)
     for (int r = 0; r < R; r++) {
         const float *sz = c->sz + (size_t)(r / m) * h1;
         float u = uv[2 * (r % m)], v = uv[2 * (r % m) + 1];
@@ -133,7 +132,7 @@ static void layer1_backward_rows(const tcb_atlas_decoder_cache *c, const float *
     int m = c->m, R = c->nz * m;
     size_t blk = (size_t)R * h1;
     const float *wu = c->wuv, *wv = c->wuv + h1;
-#pragma omp parallel for schedule(static) if ((double)R * h1 > PAR_MIN)
+#pragma omp parallel for schedule(static) if ((double)R * h1 > TCB_PAR_MIN)
     for (int r = 0; r < R; r++) {
         float u = uv[2 * (r % m)], v = uv[2 * (r % m) + 1];
         const float *s1 = c->s1 + (size_t)r * h1, *g = da + (size_t)r * h1;
