@@ -28,8 +28,9 @@ static int imin(int a, int b) { return a < b ? a : b; }
  * build runs a call made inside a parallel region on its caller's thread).
  * Why not OpenBLAS's own threads: on the layers' tall narrow products
  * (rows ≫ n, k ≤ 128) they wait on one another's packed panels; at two
- * threads this split ran cc's and dynosurf's layers 1.05–1.8× faster
- * forward and 1.0–1.2× backward, neupig's 512-wide one as fast
+ * threads this split ran cc's 64-wide layers 1.6–1.75× faster forward
+ * and 1.1–1.2× backward, dynosurf's 128-wide ones 1.1×, the 512- and
+ * 1 024-wide ones as fast
  * (bench/linear.c; docs/protocol.md, "Row-split products").
  * The blocks depend on the thread count only, so a given count gives the
  * same bits every run; one thread is the one call as before. (OpenBLAS's

@@ -14,8 +14,8 @@ Like with like: the check runs twice, with torch in float64 (the exact
 reference for the float32 C code) and in float32.
 Pass: for every tensor, max |C − torch| ≤ 1e-4 · max |torch| (the biases
 whose exact gradient is zero, cc_torch.BEFORE_BN: against the gradient of
-the layer's weight), except the gradients against float32 torch:
-≤ GRAD_TOL = 3e-4 · max |torch| (below); for the running statistics also max |C − torch| ≤ 1e-4 ·
+the layer's weight), except the gradients: ≤ GRAD_TOL = 3e-4 · max |torch|
+(below); for the running statistics also max |C − torch| ≤ 1e-4 ·
 max |Δ_torch|, Δ the movement of the forward (the variances start near 1
 and move by ~0.1: relative to the values alone a wrong batch variance
 could hide).
@@ -29,11 +29,15 @@ the network is conditioned so: torch float32 against float64 differs by
 1.5e-5 in the output and 5.9e-5 in the gradients (printed as "torch32";
 7.8e-6 and 5.5e-5 on the earlier machine): each predicted W + I and the
 batch norms over B = 3 shapes amplify rounding. That is why the
-gradients against float32 torch get GRAD_TOL, five times torch's own
-float32 error: there the rounding of both sides adds up, and C's gradient
-of decoder.MLP.fc_1.bn0.weight came to 1.04e-4, over a flat 1e-4. Against
-float64 torch, the exact reference, they keep 1e-4. The gradient controls
-below still fail by 15× GRAD_TOL and more.
+gradients get GRAD_TOL, five times torch's own float32 error: against
+float32 torch the rounding of both sides adds up (C's gradient of
+decoder.MLP.fc_1.bn0.weight came to 1.04e-4, over a flat 1e-4), and C is
+float32 against float64 torch too: on the AMD EPYC of 2026-12-07 that
+gradient is 1.05e-4 from float64 torch at one thread (6.5e-5 at two
+threads with OpenBLAS's threaded products, 1.05e-4 again once the layers'
+products ran as row blocks, whose small products are one call at any
+count), against torch float32's own 5.5e-5 to 5.9e-5. The gradient
+controls below still fail by 15× GRAD_TOL and more.
 Negative controls (--perturb=WHAT makes torch deliberately
 wrong) fail, worst errors: momentum 0.1001: running statistics 1.0e-3 of
 the movement, eval output 4.2e-4; biased (not n/(n−1)) variance in the
@@ -209,7 +213,7 @@ def main():
             row.append(f"torch32 {self32:.2e}")
         print(f"torch {name}: " + "; ".join(row))
         for k, e in allerr.items():
-            tol = GRAD_TOL if exact_grads is not None and k.startswith("grad ") else TOL
+            tol = GRAD_TOL if k.startswith("grad ") else TOL
             if not e <= tol:
                 print(f"FAIL torch {name}: {k}: max error {e:.3g} > {tol:g}")
                 failures += 1
