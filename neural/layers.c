@@ -17,7 +17,9 @@
  * sum runs over the rows in order whatever the thread count. */
 #define CHUNK 64
 
-/* Below this many multiply-adds a product runs as one OpenBLAS call. */
+/* Below this many multiply-adds (tens of microseconds) a product is left
+ * to one OpenBLAS call, which threads it or not by its own measure: a team
+ * of blocks would save less than it costs to start. */
 #define SPLIT_MIN 1048576.0
 
 static int imin(int a, int b) { return a < b ? a : b; }
